@@ -1,0 +1,78 @@
+# ibmdem — build, test, validate, benchmark.
+#   make            build build/ibmdem and the test/bench programs
+#   make test       install missing Debian packages, build, run the test suite (1 and 2 ranks)
+#   make demo       install, build, run the built-in demo case and plot it
+#   make validate   full-size validation cases (long)
+#   make bench      benchmarks, results appended to docs/performance.md
+#   make deps       install missing Debian packages (apt-get)
+#   SANITIZE=1      build with AddressSanitizer + UBSan into build-san/
+
+CC      := mpicc
+STD     := -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
+WARN    := -Wall -Wextra -Wno-unused-parameter
+HDF5_CFLAGS := $(shell pkg-config --cflags hdf5-openmpi 2>/dev/null)
+HDF5_LIBS   := $(shell pkg-config --libs hdf5-openmpi 2>/dev/null)
+ifeq ($(SANITIZE),1)
+BUILD   ?= build-san
+OPT     := -O1 -g -fno-omit-frame-pointer -fsanitize=address,undefined
+else
+BUILD   ?= build
+OPT     := -O3 -march=native -g
+endif
+CFLAGS  := $(STD) $(OPT) $(WARN) -Iinclude $(HDF5_CFLAGS) $(EXTRA_CFLAGS)
+LDLIBS  := $(HDF5_LIBS) -lfftw3 -linih -lgsl -lgslcblas -lm
+TESTLIBS := -lcmocka
+
+SRC     := $(filter-out src/main.c,$(shell find src -name '*.c' | sort))
+OBJ     := $(patsubst src/%.c,$(BUILD)/obj/%.o,$(SRC))
+DEP     := $(OBJ:.o=.d)
+LIB     := $(BUILD)/libibmdem.a
+BIN     := $(BUILD)/ibmdem
+TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
+BENCHES := $(patsubst bench/%.c,$(BUILD)/bench/%,$(wildcard bench/bench_*.c))
+
+.PHONY: all test demo validate bench deps clean restitution
+all: $(BIN) $(TESTS) $(BENCHES)
+
+$(BUILD)/obj/%.o: src/%.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
+
+$(LIB): $(OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
+$(BIN): src/main.c $(LIB)
+	$(CC) $(CFLAGS) $< $(LIB) $(LDLIBS) -o $@
+
+$(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -Itests $< $(LIB) $(LDLIBS) $(TESTLIBS) -o $@
+
+$(BUILD)/bench/%: bench/%.c $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $< $(LIB) $(LDLIBS) -o $@
+
+-include $(DEP)
+
+deps:
+	@bash scripts/deps.sh
+
+test: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bash tests/run.sh
+
+demo: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	@BUILD=$(BUILD) bash scripts/demo.sh
+
+validate: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bash scripts/validate.sh
+
+bench: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bash bench/run.sh
+
+clean:
+	rm -rf build build-san

@@ -1,0 +1,108 @@
+/* poisson.h — elliptic solves on the MAC grid: the pressure Poisson problem
+ * and the Helmholtz problems of the implicit (Crank–Nicolson) viscous term.
+ *
+ * Every solve is   (L − λ I) x = b   on the interior unknowns of one variable
+ * location, where L is the discrete Laplacian defined ONCE, in
+ * poisson_apply() (src/poisson/poisson.c), with homogeneous boundary
+ * conditions derived from the grid's faces:
+ *
+ *   location      periodic   no-slip wall          free-slip wall   axis (r = 0)
+ *   VAR_P         periodic   Neumann               Neumann          r-weighted flux = 0
+ *   normal comp.  periodic   Dirichlet on the face (unknown lies on the boundary: 0)  u_r = 0
+ *   tangential    periodic   Dirichlet (ghost = −interior)  Neumann  Neumann (r-weighted)
+ *
+ * For VAR_P, L = D·G, the divergence of the gradient used by the projection,
+ * so a projected field is divergence-free to round-off.  For velocity
+ * components, L is the vector Laplacian (axisymmetric u_r: ∂r[(1/r)∂r(r u_r)],
+ * which equals (1/r)∂r(r∂r u_r) − u_r/r² and stays second order at the axis).
+ * The fluid adds the inhomogeneous wall values to b itself.
+ *
+ * Methods (chosen in the case file, [poisson] method): "fft" — eigenfunction
+ * expansion with FFTW real transforms in y and z and tridiagonal solves in x;
+ * "multigrid" — geometric V-cycles on the same operator.
+ */
+#ifndef IBMDEM_POISSON_H
+#define IBMDEM_POISSON_H
+
+#include "config.h"
+#include "grid.h"
+
+typedef enum { POISSON_FFT = 0, POISSON_MG = 1 } poisson_method_t;
+typedef enum { VAR_P = -1, VAR_U = 0, VAR_V = 1, VAR_W = 2 } var_loc_t;
+
+/* Homogeneous boundary type of one face for one variable location. */
+typedef enum { EBC_PERIODIC = 0, EBC_NEUMANN, EBC_DIRICHLET_FACE, EBC_DIRICHLET_GHOST } ebc_t;
+
+typedef struct {
+    poisson_method_t method;
+    double mg_tol;     /* multigrid: relative residual tolerance */
+    int mg_max_cycles; /* multigrid: maximum V-cycles */
+    int mg_pre, mg_post; /* multigrid: smoothing sweeps */
+} poisson_opts_t;
+
+typedef struct poisson poisson_t;
+
+/* Solver back-end: a method implements these (fft.c, multigrid.c). */
+typedef struct {
+    void *(*create)(poisson_t *p);
+    int (*solve)(poisson_t *p, void *impl, double lambda, const double *b, double *x);
+    void (*destroy)(void *impl);
+} poisson_backend_t;
+
+struct poisson {
+    const grid_t *g;
+    var_loc_t loc;
+    poisson_opts_t opt;
+    ebc_t ebc[3][2];      /* homogeneous BC of each face for this location */
+    int nu[3];            /* global number of unknowns in each direction: indices 0..nu-1
+                           * (a Dirichlet face on the low side is the ghost index −1, on the
+                           * high side the index n−1, so it is never an unknown) */
+    int singular;         /* λ = 0 has a constant null space (all faces periodic/Neumann) */
+    /* x part of L (global, stretched/axisymmetric metric included):
+     *   (L_x x)_i = cw[i] x[i−1] + ce[i] x[i+1] − cd[i] x[i],  i = 0..nu[0]−1.
+     * At a non-periodic end the outer coefficient is 0 and the boundary
+     * condition is folded into cd; at a periodic end x[−1] ≡ x[nu−1]. */
+    double *cw, *ce, *cd;
+    /* y and z parts: uniform 3-point stencils (x[j+1] − 2x[j] + x[j−1])/dy²
+     * with the homogeneous BC applied through the ghosts. */
+    double cy, cz;        /* 1/dy², 1/dz² (cz = 0 in 2-D) */
+    const poisson_backend_t *backend;
+    void *impl;
+    /* statistics of the last solve */
+    double last_residual; /* relative residual ||b − A x|| / ||b|| (measured) */
+    int last_iterations;  /* V-cycles (multigrid) or 1 (direct) */
+};
+
+void poisson_register_keys(void);
+void poisson_opts_from_config(cfg_t *cfg, poisson_opts_t *o);
+
+poisson_t *poisson_create(const grid_t *g, var_loc_t loc, const poisson_opts_t *opt);
+void poisson_free(poisson_t *p);
+
+/* Solve (L − λI) x = b.  b and x are fields of the grid (x may equal b);
+ * only interior unknowns of b are read and of x written (a Dirichlet-face
+ * boundary value of x is set to 0).  For a singular problem (λ = 0, no
+ * Dirichlet face) the mean of b is removed first and x has zero mean.
+ * Returns 0, or −1 if an iterative method did not converge. */
+int poisson_solve(poisson_t *p, double lambda, const double *b, double *x);
+
+/* y = (L − λI) x on the interior unknowns.  Fills the ghosts of x first
+ * (halo exchange + homogeneous BC), so x is modified in its ghosts only. */
+void poisson_apply(poisson_t *p, double lambda, double *x, double *y);
+
+/* Fill the ghosts of x with the homogeneous BCs of this location (after a
+ * halo exchange). */
+void poisson_fill_ghosts(const poisson_t *p, double *x);
+
+/* Is (i,j,k) (local) an unknown of this location? */
+int poisson_is_unknown(const poisson_t *p, int i, int j, int k);
+
+/* Relative residual ||b − (L − λI)x||₂ / ||b||₂ over the unknowns (uses a
+ * scratch field; for tests and diagnostics). */
+double poisson_residual(poisson_t *p, double lambda, const double *b, double *x);
+
+/* Back-ends */
+extern const poisson_backend_t poisson_backend_fft;
+extern const poisson_backend_t poisson_backend_mg;
+
+#endif

@@ -1,0 +1,11 @@
+/* modules.c — one place that knows every module's schema of keys. */
+#include "modules.h"
+
+#include "grid.h"
+#include "poisson.h"
+
+void modules_register_keys(void)
+{
+    grid_register_keys();
+    poisson_register_keys();
+}

@@ -1,0 +1,270 @@
+/* grid.c — staggered grid geometry, slab decomposition in x, halo exchange. */
+#include "grid.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util.h"
+
+static const cfg_key_t grid_keys[] = {
+    {"domain", "geometry", CFG_ENUM, "3d", 1, 0, "3d|2d|axisymmetric",
+     "3d Cartesian, 2d planar (x, y), or axisymmetric (x = r from the axis, y = axial)"},
+    {"domain", "nx", CFG_INT, NULL, 1, 1 << 20, NULL, "cells in x (r when axisymmetric); must divide by the rank count"},
+    {"domain", "ny", CFG_INT, NULL, 1, 1 << 20, NULL, "cells in y"},
+    {"domain", "nz", CFG_INT, "1", 1, 1 << 20, NULL, "cells in z (must be 1 in 2d and axisymmetric)"},
+    {"domain", "length", CFG_VEC3, NULL, 1e-300, 1e300, NULL, "domain size Lx Ly Lz (Lz ignored in 2-D)"},
+    {"domain", "origin", CFG_VEC3, "0 0 0", -1e300, 1e300, NULL, "low corner of the domain (x must be 0 when axisymmetric)"},
+    {"domain", "x_stretch", CFG_ENUM, "uniform", 1, 0, "uniform|tanh_low|tanh_high|tanh_both",
+     "spacing in x: uniform, or tanh clustering at the low, high or both x faces"},
+    {"domain", "x_stretch_beta", CFG_DOUBLE, "2.0", 1e-6, 20, NULL, "strength of the tanh clustering"},
+#define FACE_KEYS(F)                                                                                        \
+    {"boundary", F, CFG_ENUM, "periodic", 1, 0, "periodic|noslip|freeslip|axis",                             \
+     "boundary condition on this face (axis: only x_lo of an axisymmetric grid)"},                          \
+        {"boundary", F "_velocity", CFG_VEC3, "0 0 0", -1e300, 1e300, NULL,                                    \
+         "velocity (u v w) of a no-slip wall on this face; the normal component must be 0"}
+    FACE_KEYS("x_lo"), FACE_KEYS("x_hi"), FACE_KEYS("y_lo"), FACE_KEYS("y_hi"), FACE_KEYS("z_lo"),
+    FACE_KEYS("z_hi"),
+#undef FACE_KEYS
+    {NULL, NULL, 0, NULL, 0, 0, NULL, NULL}};
+
+void grid_register_keys(void) { cfg_schema_add(grid_keys); }
+
+static const char *face_name[3][2] = {{"x_lo", "x_hi"}, {"y_lo", "y_hi"}, {"z_lo", "z_hi"}};
+
+grid_t *grid_create_from_config(cfg_t *cfg, MPI_Comm comm)
+{
+    geom_t geom = (geom_t)cfg_enum(cfg, "domain", "geometry");
+    int n[3] = {cfg_int(cfg, "domain", "nx"), cfg_int(cfg, "domain", "ny"), cfg_int(cfg, "domain", "nz")};
+    double L[3], x0[3];
+    cfg_vec3(cfg, "domain", "length", L);
+    cfg_vec3(cfg, "domain", "origin", x0);
+    stretch_t st = (stretch_t)cfg_enum(cfg, "domain", "x_stretch");
+    double beta = cfg_double(cfg, "domain", "x_stretch_beta");
+    bc_t bc;
+    memset(&bc, 0, sizeof bc);
+    for (int d = 0; d < 3; d++)
+        for (int s = 0; s < 2; s++) {
+            char vk[32];
+            bc.type[d][s] = (bc_type_t)cfg_enum(cfg, "boundary", face_name[d][s]);
+            snprintf(vk, sizeof vk, "%s_velocity", face_name[d][s]);
+            cfg_vec3(cfg, "boundary", vk, bc.vel[d][s]);
+        }
+    int nranks;
+    MPI_Comm_size(comm, &nranks);
+
+    /* Consistency checks, each naming the key at fault. */
+    if (geom != GEOM_3D) {
+        if (n[2] != 1) cfg_fail(cfg, "domain", "nz", "must be 1 for a %s grid (got %d)",
+                                geom == GEOM_2D ? "2d" : "axisymmetric", n[2]);
+        for (int s = 0; s < 2; s++)
+            if (bc.type[2][s] != BC_PERIODIC)
+                cfg_fail(cfg, "boundary", face_name[2][s], "a 2-D grid has no z faces: leave it periodic");
+        L[2] = 1.0;
+    }
+    for (int d = 0; d < 3; d++) {
+        if ((bc.type[d][0] == BC_PERIODIC) != (bc.type[d][1] == BC_PERIODIC))
+            cfg_fail(cfg, "boundary", face_name[d][bc.type[d][0] == BC_PERIODIC ? 1 : 0],
+                     "periodic on one %c face only: both %s and %s must be periodic, or neither", "xyz"[d],
+                     face_name[d][0], face_name[d][1]);
+        for (int s = 0; s < 2; s++) {
+            if (bc.type[d][s] == BC_AXIS && !(geom == GEOM_AXI && d == 0 && s == 0))
+                cfg_fail(cfg, "boundary", face_name[d][s], "'axis' is only valid for x_lo of an axisymmetric grid");
+            char vk[32];
+            snprintf(vk, sizeof vk, "%s_velocity", face_name[d][s]);
+            if (bc.vel[d][s][d] != 0.0)
+                cfg_fail(cfg, "boundary", vk, "the normal component (%c) of a wall velocity must be 0",
+                         "uvw"[d]);
+            if (bc.type[d][s] != BC_NOSLIP && (bc.vel[d][s][0] || bc.vel[d][s][1] || bc.vel[d][s][2]))
+                cfg_fail(cfg, "boundary", vk, "a wall velocity needs %s = noslip", face_name[d][s]);
+        }
+    }
+    if (geom == GEOM_AXI) {
+        if (bc.type[0][0] != BC_AXIS) cfg_fail(cfg, "boundary", "x_lo", "an axisymmetric grid needs x_lo = axis");
+        if (x0[0] != 0.0) cfg_fail(cfg, "domain", "origin", "an axisymmetric grid starts at the axis: x must be 0");
+    }
+    if (st != STRETCH_UNIFORM && bc.type[0][0] == BC_PERIODIC)
+        cfg_fail(cfg, "domain", "x_stretch", "a periodic x direction must be uniform");
+    if (geom == GEOM_AXI && (st == STRETCH_TANH_LOW || st == STRETCH_TANH_BOTH))
+        cfg_fail(cfg, "domain", "x_stretch", "clustering at the axis is not allowed (use uniform or tanh_high)");
+    if (n[0] % nranks != 0)
+        cfg_fail(cfg, "domain", "nx", "%d cells do not divide among %d ranks (slabs in x)", n[0], nranks);
+    if (n[0] / nranks < 2)
+        cfg_fail(cfg, "domain", "nx", "%d cells among %d ranks leaves fewer than 2 per rank", n[0], nranks);
+    return grid_create(geom, n, L, x0, &bc, st, beta, comm);
+}
+
+/* Face positions in x: uniform, or a tanh map of the uniform coordinate s in
+ * [0,1] that clusters faces near the chosen walls (Vinokur-type). */
+static double stretch_map(stretch_t st, double beta, double s)
+{
+    switch (st) {
+    case STRETCH_UNIFORM: return s;
+    case STRETCH_TANH_LOW: return 1.0 + tanh(beta * (s - 1.0)) / tanh(beta);
+    case STRETCH_TANH_HIGH: return tanh(beta * s) / tanh(beta);
+    case STRETCH_TANH_BOTH: return 0.5 * (1.0 + tanh(beta * (s - 0.5)) / tanh(0.5 * beta));
+    }
+    return s;
+}
+
+grid_t *grid_create(geom_t geom, const int n[3], const double L[3], const double x0[3], const bc_t *bc,
+                    stretch_t stretch, double beta, MPI_Comm comm)
+{
+    grid_t *g = xcalloc(1, sizeof *g);
+    g->geom = geom;
+    g->dim = geom == GEOM_3D ? 3 : 2;
+    for (int d = 0; d < 3; d++) {
+        g->n[d] = n[d];
+        g->L[d] = L[d];
+        g->x0[d] = x0 ? x0[d] : 0.0;
+    }
+    if (g->dim == 2) g->n[2] = 1;
+    if (bc)
+        g->bc = *bc;
+    else
+        memset(&g->bc, 0, sizeof g->bc); /* BC_PERIODIC == 0 */
+    for (int d = 0; d < 3; d++) g->periodic[d] = g->bc.type[d][0] == BC_PERIODIC;
+    if (g->dim == 2) g->periodic[2] = 1;
+    g->stretch = stretch;
+    g->stretch_beta = beta;
+
+    g->comm = comm;
+    MPI_Comm_rank(comm, &g->rank);
+    MPI_Comm_size(comm, &g->nranks);
+    if (g->n[0] % g->nranks) die("nx = %d does not divide among %d ranks", g->n[0], g->nranks);
+    g->nxl = g->n[0] / g->nranks;
+    g->ix0 = g->rank * g->nxl;
+    g->left = g->rank > 0 ? g->rank - 1 : (g->periodic[0] ? g->nranks - 1 : MPI_PROC_NULL);
+    g->right = g->rank < g->nranks - 1 ? g->rank + 1 : (g->periodic[0] ? 0 : MPI_PROC_NULL);
+
+    g->gz = g->dim == 3 ? 1 : 0;
+    g->sy = g->n[2] + 2 * g->gz;
+    g->sx = (long)(g->n[1] + 2) * g->sy;
+    g->nalloc = (long)(g->nxl + 2) * g->sx;
+    g->ncell_local = (long)g->nxl * g->n[1] * g->n[2];
+
+    g->dy = g->L[1] / g->n[1];
+    g->dz = g->L[2] / g->n[2];
+
+    /* Global x arrays, index -1..nx stored at offset +1. */
+    int nx = g->n[0];
+    double *buf = xcalloc((size_t)4 * (nx + 2), sizeof(double));
+    g->gxf = buf + 1;
+    g->gxc = buf + (nx + 2) + 1;
+    g->gdxf = buf + 2 * (nx + 2) + 1;
+    g->gdxc = buf + 3 * (nx + 2) + 1;
+    for (int i = -1; i < nx; i++) g->gxf[i] = g->x0[0] + g->L[0] * stretch_map(stretch, beta, (double)(i + 1) / nx);
+    g->gxf[-1] = g->x0[0];
+    g->gxf[nx - 1] = g->x0[0] + g->L[0];
+    /* Ghost face beyond the high boundary: mirror of the last cell. */
+    g->gxf[nx] = g->gxf[nx - 1] + (g->gxf[nx - 1] - g->gxf[nx - 2]);
+    for (int i = 0; i <= nx; i++) g->gdxf[i] = g->gxf[i] - g->gxf[i - 1];
+    g->gdxf[-1] = g->gdxf[0]; /* ghost cell mirrors the first cell (periodic or wall) */
+    if (g->periodic[0]) {
+        g->gdxf[-1] = g->gdxf[nx - 1];
+        g->gdxf[nx] = g->gdxf[0];
+    }
+    for (int i = 0; i < nx; i++) g->gxc[i] = 0.5 * (g->gxf[i] + g->gxf[i - 1]);
+    g->gxc[-1] = g->gxf[-1] - 0.5 * g->gdxf[-1];
+    g->gxc[nx] = g->gxf[nx - 1] + 0.5 * g->gdxf[nx];
+    for (int i = -1; i < nx; i++) g->gdxc[i] = g->gxc[i + 1] - g->gxc[i];
+    g->gdxc[nx] = g->gdxc[nx - 1];
+
+    /* Local views. */
+    double *lb = xcalloc((size_t)4 * (g->nxl + 2), sizeof(double));
+    g->xf = lb + 1;
+    g->xc = lb + (g->nxl + 2) + 1;
+    g->dxf = lb + 2 * (g->nxl + 2) + 1;
+    g->dxc = lb + 3 * (g->nxl + 2) + 1;
+    for (int i = -1; i <= g->nxl; i++) {
+        int ig = i + g->ix0;
+        g->xf[i] = g->gxf[ig];
+        g->xc[i] = g->gxc[ig];
+        g->dxf[i] = g->gdxf[ig];
+        g->dxc[i] = g->gdxc[ig];
+    }
+    return g;
+}
+
+void grid_free(grid_t *g)
+{
+    if (!g) return;
+    free(g->gxf - 1);
+    free(g->xf - 1);
+    free(g);
+}
+
+double *field_alloc(const grid_t *g) { return xcalloc((size_t)g->nalloc, sizeof(double)); }
+void field_copy(const grid_t *g, double *dst, const double *src) { memcpy(dst, src, (size_t)g->nalloc * sizeof(double)); }
+void field_zero(const grid_t *g, double *f) { memset(f, 0, (size_t)g->nalloc * sizeof(double)); }
+
+void grid_halo_yz(const grid_t *g, double *f)
+{
+    int ny = g->n[1], nz = g->n[2];
+    for (int i = -1; i <= g->nxl; i++) {
+        if (g->dim == 3 && g->periodic[2])
+            for (int j = 0; j < ny; j++) {
+                f[G_IDX(g, i, j, -1)] = f[G_IDX(g, i, j, nz - 1)];
+                f[G_IDX(g, i, j, nz)] = f[G_IDX(g, i, j, 0)];
+            }
+        if (g->periodic[1]) {
+            double *dst_lo = f + G_IDX(g, i, -1, -g->gz), *dst_hi = f + G_IDX(g, i, ny, -g->gz);
+            const double *src_lo = f + G_IDX(g, i, ny - 1, -g->gz), *src_hi = f + G_IDX(g, i, 0, -g->gz);
+            memcpy(dst_lo, src_lo, (size_t)g->sy * sizeof(double));
+            memcpy(dst_hi, src_hi, (size_t)g->sy * sizeof(double));
+        }
+    }
+}
+
+void grid_halo_x(const grid_t *g, double *f)
+{
+    /* Planes i = 0 and i = nxl-1 (with their y/z ghosts) go to the neighbours'
+     * ghost planes i = nxl and i = -1. */
+    long np = g->sx;
+    double *first = f + G_IDX(g, 0, -1, -g->gz), *last = f + G_IDX(g, g->nxl - 1, -1, -g->gz);
+    double *ghost_lo = f + G_IDX(g, -1, -1, -g->gz), *ghost_hi = f + G_IDX(g, g->nxl, -1, -g->gz);
+    if (g->nranks == 1) {
+        if (g->periodic[0]) {
+            memcpy(ghost_lo, last, (size_t)np * sizeof(double));
+            memcpy(ghost_hi, first, (size_t)np * sizeof(double));
+        }
+        return;
+    }
+    MPI_Sendrecv(last, (int)np, MPI_DOUBLE, g->right, 11, ghost_lo, (int)np, MPI_DOUBLE, g->left, 11, g->comm,
+                 MPI_STATUS_IGNORE);
+    MPI_Sendrecv(first, (int)np, MPI_DOUBLE, g->left, 12, ghost_hi, (int)np, MPI_DOUBLE, g->right, 12, g->comm,
+                 MPI_STATUS_IGNORE);
+}
+
+void grid_halo(const grid_t *g, double *f)
+{
+    grid_halo_yz(g, f);
+    grid_halo_x(g, f);
+}
+
+double grid_sum(const grid_t *g, double v)
+{
+    double r;
+    MPI_Allreduce(&v, &r, 1, MPI_DOUBLE, MPI_SUM, g->comm);
+    return r;
+}
+
+double grid_max(const grid_t *g, double v)
+{
+    double r;
+    MPI_Allreduce(&v, &r, 1, MPI_DOUBLE, MPI_MAX, g->comm);
+    return r;
+}
+
+double grid_min(const grid_t *g, double v)
+{
+    double r;
+    MPI_Allreduce(&v, &r, 1, MPI_DOUBLE, MPI_MIN, g->comm);
+    return r;
+}
+
+double grid_cell_volume(const grid_t *g, int i)
+{
+    if (g->geom == GEOM_AXI) return g->xc[i] * g->dxf[i] * g->dy;
+    return g->dxf[i] * g->dy * (g->dim == 3 ? g->dz : 1.0);
+}
