@@ -178,12 +178,15 @@ typedef struct {
     double frac0;      /* progress at the start (a restart does not start at 0) */
     long step0;
     double last;       /* wall time of the last refresh */
-    int shown;         /* a line is on screen */
+    int shown;         /* length of the line on screen (0: none) */
 } io_progress_t;
 
-/* The line is only drawn when stdout is a terminal (isatty), refreshed in
- * place with \r at most every 0.25 s: simulated time, percent, steps/s, ETA. */
-void io_progress_start(io_progress_t *p, double frac, long step);
+/* The line (simulated time, percent, steps/s, ETA) is redrawn in place with
+ * \r at most every 0.25 s, on rank 0.  mode 0 (auto): only when stdout is a
+ * terminal and the program was not started by mpirun — Open MPI gives its
+ * processes a pseudo-terminal whatever mpirun's own output is, so isatty
+ * cannot tell there; 1: always; 2: never. */
+void io_progress_start(io_progress_t *p, double frac, long step, int mode);
 /* frac = progress in [0, 1] (the largest of the fractions of t_end,
  * max_steps and wall_limit). */
 void io_progress_update(io_progress_t *p, double time, long step, double frac);

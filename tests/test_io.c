@@ -314,7 +314,9 @@ int main(int argc, char **argv)
     int all;
     MPI_Allreduce(&fails, &all, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     MPI_Barrier(MPI_COMM_WORLD);
-    if (mpi_rank() == 0 && all == 0) {
+    if (mpi_rank() == 0 && getenv("IBMDEM_TEST_KEEP")) {
+        printf("files kept in %s\n", tmpdir);
+    } else if (mpi_rank() == 0 && all == 0) {
         char cmd[300];
         snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
         if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", tmpdir);

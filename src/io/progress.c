@@ -3,14 +3,21 @@
  * terminal: a log or a pipe gets no carriage returns. */
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <unistd.h>
 
 #include "io.h"
 #include "util.h"
 
-void io_progress_start(io_progress_t *p, double frac, long step)
+static int under_mpirun(void)
 {
-    p->active = mpi_rank() == 0 && isatty(fileno(stdout));
+    return getenv("OMPI_COMM_WORLD_SIZE") || getenv("PMI_RANK") || getenv("PMIX_RANK");
+}
+
+void io_progress_start(io_progress_t *p, double frac, long step, int mode)
+{
+    int want = mode == 1 || (mode == 0 && isatty(fileno(stdout)) && !under_mpirun());
+    p->active = mpi_rank() == 0 && want;
     p->wall0 = wtime();
     p->frac0 = frac;
     p->step0 = step;
@@ -41,16 +48,16 @@ void io_progress_update(io_progress_t *p, double time, long step, double frac)
     double eta = frac > p->frac0 ? el * (1.0 - frac) / (frac - p->frac0) : NAN;
     char etas[32];
     format_duration(eta, etas, sizeof etas);
-    printf("\r  t = %-12.6g %5.1f %%  step %-9ld %8.1f steps/s  ETA %-8s", time, 100.0 * fmin(frac, 1.0), step, rate,
-           etas);
+    int len = printf("\r  t = %-12.6g %5.1f %%  step %-9ld %8.1f steps/s  ETA %-8s", time, 100.0 * fmin(frac, 1.0),
+                     step, rate, etas);
     fflush(stdout);
-    p->shown = 1;
+    p->shown = len;
 }
 
 void io_progress_clear(io_progress_t *p)
 {
     if (!p->active || !p->shown) return;
-    printf("\r%80s\r", "");
+    printf("\r%*s\r", p->shown, "");
     fflush(stdout);
     p->shown = 0;
 }
