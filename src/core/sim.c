@@ -152,7 +152,7 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
     /* (particles / DEM, immersed boundary coupling, pore network: add here) */
 
     if (s->npart == 0) {
-        if (mpi_rank() == 0) fprintf(stderr, "%s: nothing to simulate: the case has no [fluid] section\n", cfg_path(cfg));
+        if (mpi_rank() == 0) fprintf(stderr, "%s: nothing to simulate: the case has no [fluid] section (with at least one key)\n", cfg_path(cfg));
         MPI_Finalize();
         exit(2);
     }
@@ -352,6 +352,8 @@ static int stop_diverged(sim_t *s)
 {
     long bad_step = s->step;
     double bad_time = s->time;
+    io_progress_clear(&s->progress);
+    write_series_row(s); /* the failed step, as it came out */
     int restored = s->prm.rollback;
     for (int i = 0; i < s->npart && restored; i++) restored = s->part[i].restore_previous != NULL;
     if (restored) {
@@ -359,8 +361,6 @@ static int stop_diverged(sim_t *s)
         s->time = s->time_prev;
         s->step = s->step_prev;
     }
-    io_progress_clear(&s->progress);
-    write_series_row(s);
     write_checkpoint(s);
     s->status = SIM_DIVERGED;
     write_summary(s);
