@@ -4,13 +4,8 @@
 # (no line when the key is absent or given by --set); a diverging run stops
 # with status 3, a message and a checkpoint that --restart accepts.
 # Prints TAP lines (ok N - ... / not ok N - ...).
-cd "$(dirname "$0")/.."
-BUILD=${BUILD:-build}
-BIN=$PWD/$BUILD/ibmdem
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
-MPIRUN="mpirun --allow-run-as-root --oversubscribe"
+. "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_bad_input.XXXXXX)
-n=0; failed=0
 
 # The base case: a small lid-driven cavity.  Line numbers matter below.
 base() {
@@ -37,15 +32,13 @@ INI
 # check NAME STATUS REGEX -- COMMAND...: run, then assert status and stderr
 check() {
     local name=$1 want=$2 regex=$3; shift 4
-    n=$((n + 1))
     "$@" >"$T/out" 2>"$T/err"
     local rc=$?
     if [ "$rc" = "$want" ] && { [ -z "$regex" ] || grep -Eq -- "$regex" "$T/err"; }; then
-        echo "ok $n - $name"
+        report 0 "$name"
     else
-        echo "not ok $n - $name (status $rc, want $want; stderr below, want /$regex/)"
+        report 1 "$name (status $rc, want $want; stderr below, want /$regex/)"
         sed 's/^/#   /' "$T/err" | head -5
-        failed=$((failed + 1))
     fi
 }
 
@@ -104,20 +97,13 @@ out=$T/diverge
 check "a diverging run stops with a message" 3 \
     "^error: the run diverged at step 1 .*CFL = [0-9.]+ is above the hard limit 1.5 \(time.cfl_abort\)" -- \
     $BIN run "$f" --set fluid.dt=0.5 --set time.t_end=10 --out "$out"
-n=$((n + 1))
-if [ -f "$out/checkpoint_00000000.h5" ] && grep -q "is saved in $out/checkpoint_00000000.h5" "$T/err" &&
-   /usr/bin/python3 -c "import json,sys; d=json.load(open('$out/summary.json')); sys.exit(d['status']!='diverged')"; then
-    echo "ok $n - the diverged run left checkpoint_00000000.h5 and summary.json status = diverged"
-else
-    echo "not ok $n - no checkpoint or summary after the divergence"; failed=$((failed + 1))
-fi
+[ -f "$out/checkpoint_00000000.h5" ] && grep -q "is saved in $out/checkpoint_00000000.h5" "$T/err" &&
+    $PY -c "import json,sys; d=json.load(open('$out/summary.json')); sys.exit(d['status']!='diverged')"
+report $? "the diverged run left checkpoint_00000000.h5 and summary.json status = diverged"
 check "--restart accepts that checkpoint (with a stable dt)" 0 "fluid.dt: 0.5 in the checkpoint, 0.01 now" -- \
     $BIN run "$f" --set fluid.dt=0.01 --set time.max_steps=3 --out "$out" --restart "$out/checkpoint_00000000.h5"
-n=$((n + 1))
-if grep -q "reached max_steps at step 3" "$T/out"; then echo "ok $n - the restarted run advanced to step 3"
-else echo "not ok $n - the restarted run did not reach step 3"; failed=$((failed + 1)); fi
+grep -q "reached max_steps at step 3" "$T/out"
+report $? "the restarted run advanced to step 3"
 
 chmod 600 "$T/noperm.ini"
-[ "$failed" = 0 ] && rm -rf "$T"
-echo "1..$n"
-exit $((failed > 0))
+tap_end "$T"

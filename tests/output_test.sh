@@ -4,15 +4,8 @@
 # field snapshots indexed by a valid XDMF file (postproc/check_xdmf.py checks
 # the XDMF 2 structure and every dataset it names, with its shape), and
 # checkpoints; the same for a stretched 3-D grid.  Prints TAP lines.
-cd "$(dirname "$0")/.."
-BUILD=${BUILD:-build}
-BIN=$PWD/$BUILD/ibmdem
-PY=/usr/bin/python3
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
-MPIRUN="mpirun --allow-run-as-root --oversubscribe -np 2"
+. "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_output.XXXXXX)
-n=0; failed=0
-report() { n=$((n + 1)); if [ "$1" = 0 ]; then echo "ok $n - $2"; else echo "not ok $n - $2"; failed=$((failed + 1)); fi; }
 
 O=$T/tgv
 $MPIRUN $BIN run cases/taylor_green/taylor_green.ini --set domain.nx=32 --set domain.ny=32 --set time.t_end=1 \
@@ -90,6 +83,4 @@ sys.exit(0 if ok else 1)
 PY
 report $? "stretched 3-D channel on 2 ranks: valid XDMF, x nodes are the stretched faces"
 
-[ "$failed" = 0 ] && rm -rf "$T"
-echo "1..$n"
-exit $((failed > 0))
+tap_end "$T"

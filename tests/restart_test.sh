@@ -11,18 +11,9 @@
 # Cases: the lid-driven cavity (walls, moving lid) and the periodic 2-D
 # Taylor–Green vortex, both 16 x 16 so that the test takes seconds.
 # Prints TAP lines.
-cd "$(dirname "$0")/.."
-BUILD=${BUILD:-build}
-BIN=$PWD/$BUILD/ibmdem
-export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
-MPIRUN="mpirun --allow-run-as-root --oversubscribe"
+. "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_restart.XXXXXX)
 N=40; H=$((N / 2))
-n=0; failed=0
-report() { # report OK NAME
-    n=$((n + 1))
-    if [ "$1" = 0 ]; then echo "ok $n - $2"; else echo "not ok $n - $2"; failed=$((failed + 1)); fi
-}
 final() { printf "%s/checkpoint_%08d.h5" "$1" "$N"; }
 fields() { # the fluid datasets present in a checkpoint
     h5ls "$1/fluid" | awk '$2 == "Dataset" {print $1}'
@@ -59,7 +50,7 @@ for case in cavity taylor_green; do
         h5diff --delta=1e-12 "$(final $T/$case.np1/straight)" "$(final $T/$case.np2/straight)" /fluid/$v /fluid/$v \
             >/dev/null || { bad=2; break; }
     done
-    maxdiff=$(/usr/bin/python3 - "$(final $T/$case.np1/straight)" "$(final $T/$case.np2/straight)" <<'PY'
+    maxdiff=$($PY - "$(final $T/$case.np1/straight)" "$(final $T/$case.np2/straight)" <<'PY'
 import sys, h5py, numpy as np
 a, b = h5py.File(sys.argv[1]), h5py.File(sys.argv[2])
 print("%.2e" % max(np.abs(a["fluid"][k][...] - b["fluid"][k][...]).max() for k in a["fluid"]))
@@ -67,6 +58,4 @@ PY
 )
     report $bad "$case: 1 and 2 ranks agree to round-off after $N steps (max |difference| $maxdiff, bound 1e-12)"
 done
-[ "$failed" = 0 ] && rm -rf "$T"
-echo "1..$n"
-exit $((failed > 0))
+tap_end "$T"
