@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "config.h"
 #include "fluid.h"
 #include "grid.h"
 #include "util.h"
@@ -113,6 +114,23 @@ static inline void ft_run_to(fluid_t *f, double t_end, double dt)
         double h = fmin(dt, t_end - f->time);
         fluid_step(f, h);
     }
+}
+
+/* Build grid and fluid from a case-file text (the user's path: schema,
+ * checks, initial condition).  Stops the test program on an input error. */
+static inline fluid_t *ft_from_case(const char *text, grid_t **gp)
+{
+    cfg_t *cfg = cfg_load_string("test.ini", text, 0, NULL);
+    if (!cfg) die("test case rejected");
+    grid_t *g = grid_create_from_config(cfg, MPI_COMM_WORLD);
+    fluid_params_t prm;
+    fluid_params_from_config(cfg, g, &prm);
+    prm.poisson = ft_poisson_opts();
+    fluid_t *f = fluid_create(g, &prm);
+    fluid_init_from_config(f, cfg);
+    cfg_free(cfg);
+    *gp = g;
+    return f;
 }
 
 #endif

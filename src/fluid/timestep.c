@@ -13,6 +13,7 @@
 #include <math.h>
 
 #include "fluid_internal.h"
+#include "util.h"
 
 double fluid_convective_rate(const fluid_t *f)
 {
@@ -66,11 +67,12 @@ double fluid_stable_dt(const fluid_t *f)
     }
     double rate = fmax(fluid_convective_rate(f), fmax(uw / dmin, sqrt(fb / dmin)));
     double dt = rate > 0 ? prm->cfl / rate : DBL_MAX;
-    double dt_visc = prm->fourier / (prm->nu * viscous_rate(f));
+    double dt_visc = prm->nu > 0 ? prm->fourier / (prm->nu * viscous_rate(f)) : DBL_MAX;
     if (!prm->implicit_viscous) dt = fmin(dt, dt_visc);
     if (prm->dt_max > 0) dt = fmin(dt, prm->dt_max);
     /* implicit, at rest, unforced and without dt_max: nothing limits the step;
      * take the explicit viscous one */
     if (dt == DBL_MAX) dt = dt_visc;
+    if (dt == DBL_MAX) die("fluid_stable_dt: nothing limits the time step (inviscid fluid at rest): set dt or dt_max");
     return dt;
 }
