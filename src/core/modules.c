@@ -1,6 +1,7 @@
 /* modules.c — one place that knows every module's schema of keys. */
 #include "modules.h"
 
+#include "fluid.h"
 #include "grid.h"
 #include "poisson.h"
 #include "sim.h"
@@ -9,5 +10,6 @@ void modules_register_keys(void)
 {
     grid_register_keys();
     poisson_register_keys();
+    fluid_register_keys();
     sim_register_keys();
 }
