@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """plot_cavity.py OUTDIR [PNG] — lid-driven cavity: centreline velocities of the
-last snapshot in OUTDIR against Ghia, Ghia & Shin (1982), and a map of the
+last snapshot in OUTDIR against Ghia, Ghia & Shin (1982) at the Reynolds number
+1/nu of the run (100, 400 or 1000: cases/cavity/ghia1982.csv), and a map of the
 velocity magnitude.  Prints the largest difference from the table and writes
 OUTDIR/cavity_ghia.json with it.
 
@@ -23,10 +24,24 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 TABLE = os.path.join(HERE, "..", "cases", "cavity", "ghia1982.csv")
 
 
-def read_ghia(path=TABLE):
+def reynolds(outdir):
+    """Re = U L / nu of the run, from its resolved input (unit lid velocity and size)."""
+    section = ""
+    for line in open(os.path.join(outdir, "input.ini")):
+        line = line.split(";")[0].strip()
+        if line.startswith("["):
+            section = line.strip("[]")
+        elif section == "fluid" and line.startswith("nu") and "=" in line:
+            return round(1.0 / float(line.split("=")[1]))
+    raise SystemExit("no fluid.nu in %s/input.ini" % outdir)
+
+
+def read_ghia(re, path=TABLE):
     rows = [line.strip().split(",") for line in open(path) if line.strip() and not line.startswith("#")]
     head, rows = rows[0], rows[1:]
-    col = head.index("re100")
+    if "Re%d" % re not in head:
+        raise SystemExit("Ghia et al. tabulate Re = %s, not %d" % (", ".join(h[2:] for h in head[2:]), re))
+    col = head.index("Re%d" % re)
     out = {"u": [], "v": []}
     for r in rows:
         out[r[0]].append((float(r[1]), float(r[col])))
@@ -59,16 +74,17 @@ def main():
     x_v = np.concatenate([[xf[0]], xc, [xf[-1]]])
     v_line = np.concatenate([[0.0], vc, [0.0]])
 
-    ghia = read_ghia()
+    re = reynolds(outdir)
+    ghia = read_ghia(re)
     err_u = np.abs(np.interp(ghia["u"][:, 0], y_u, u_line) - ghia["u"][:, 1])
     err_v = np.abs(np.interp(ghia["v"][:, 0], x_v, v_line) - ghia["v"][:, 1])
     res = {"snapshot": os.path.basename(snap), "time": float(t), "grid": [len(xc), len(yc)],
            "max_abs_error_u": float(err_u.max()), "max_abs_error_v": float(err_v.max()),
-           "reference": "Ghia, Ghia & Shin (1982), J. Comput. Phys. 48, 387-411, Re = 100"}
+           "reynolds": re, "reference": "Ghia, Ghia & Shin (1982), J. Comput. Phys. 48, 387-411"}
     with open(os.path.join(outdir, "cavity_ghia.json"), "w") as f:
         json.dump(res, f, indent=2)
-    print("cavity Re = 100, %d x %d, t = %.4g: max |u - Ghia| = %.4f, max |v - Ghia| = %.4f (lid velocity 1)"
-          % (len(xc), len(yc), t, err_u.max(), err_v.max()))
+    print("cavity Re = %d, %d x %d, t = %.4g: max |u - Ghia| = %.4f, max |v - Ghia| = %.4f (lid velocity 1)"
+          % (re, len(xc), len(yc), t, err_u.max(), err_v.max()))
 
     fig, ax = plt.subplots(1, 3, figsize=(15, 4.6))
     ax[0].plot(u_line, y_u, "-", label="ibmdem %d x %d" % (len(xc), len(yc)))
@@ -92,7 +108,7 @@ def main():
     ax[2].set_xlim(xf[0], xf[-1])
     ax[2].set_ylim(yf[0], yf[-1])
     ax[2].set_title("velocity magnitude, t = %.3g" % t)
-    fig.suptitle("lid-driven cavity, Re = 100")
+    fig.suptitle("lid-driven cavity, Re = %d" % re)
     fig.tight_layout()
     fig.savefig(png, dpi=110)
     print("wrote", png)
