@@ -2,6 +2,7 @@
 #include "modules.h"
 
 #include "fluid.h"
+#include "ibm.h"
 #include "grid.h"
 #include "poisson.h"
 #include "sim.h"
@@ -11,5 +12,6 @@ void modules_register_keys(void)
     grid_register_keys();
     poisson_register_keys();
     fluid_register_keys();
+    ibm_register_keys();
     sim_register_keys();
 }

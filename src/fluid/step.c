@@ -10,7 +10,8 @@
  *            problem (L − λ) u* = −λ rhs − (wall terms), λ = 2/(α_k Δt ν)]
  *   stage hook (immersed boundary) on u*
  *   L φ   = D u* / (α_k Δt),   u^k = u* − α_k Δt G φ,
- *   p^k   = p^{k−1} + φ  [− α_k Δt ν/2 L φ when Crank–Nicolson].
+ *   p^k   = p^{k−1} + φ  [− α_k Δt ν/2 L φ when Crank–Nicolson],
+ *   stage-end hook (immersed boundary: particle update) on u^k.
  * Since L = D·G (poisson.c), D u^k = 0 to the solver's round-off.
  */
 #include <math.h>
@@ -18,8 +19,8 @@
 #include "fluid_internal.h"
 #include "util.h"
 
-static const double rk_gamma[3] = {8.0 / 15.0, 5.0 / 12.0, 3.0 / 4.0};
-static const double rk_zeta[3] = {0.0, -17.0 / 60.0, -5.0 / 12.0};
+const double fluid_rk_gamma[3] = {8.0 / 15.0, 5.0 / 12.0, 3.0 / 4.0};
+const double fluid_rk_zeta[3] = {0.0, -17.0 / 60.0, -5.0 / 12.0};
 
 /* Gradient of a cell-centred field at the unknowns of component c. */
 static inline double grad_c(const grid_t *g, int c, const double *p, long m, int i)
@@ -78,6 +79,8 @@ void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure)
     fluid_apply_bc(f);
 }
 
+void fluid_stage_project(fluid_t *f, double dt_stage) { fluid_project_stage(f, dt_stage, 1); }
+
 void fluid_project(fluid_t *f)
 {
     fluid_apply_bc(f);
@@ -89,7 +92,7 @@ static void predict_component(fluid_t *f, int c, int stage, double dt)
 {
     const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
-    double gam = rk_gamma[stage], zet = rk_zeta[stage], a = gam + zet, adt = a * dt;
+    double gam = fluid_rk_gamma[stage], zet = fluid_rk_zeta[stage], a = gam + zet, adt = a * dt;
     double *u = f->u[c], *h = q->dudt[c], *ho = q->dudt_old[c], *w = q->work;
     double fc = f->prm.body_force[c];
     int impl = f->prm.implicit_viscous;
@@ -129,7 +132,7 @@ void fluid_step(fluid_t *f, double dt)
     fluid_priv_t *q = fluid_priv(f);
     int nc = fluid_ncomp(g);
     for (int s = 0; s < 3; s++) {
-        double adt = (rk_gamma[s] + rk_zeta[s]) * dt;
+        double adt = (fluid_rk_gamma[s] + fluid_rk_zeta[s]) * dt;
         /* H^k from u^{k−1} (its ghosts are valid: every stage ends with them) */
         for (int c = 0; c < nc; c++) field_zero(g, q->dudt[c]);
         fluid_advection_add(f, -1.0, q->dudt);
@@ -147,6 +150,7 @@ void fluid_step(fluid_t *f, double dt)
             fluid_apply_bc(f);
         }
         fluid_project_stage(f, adt, 1);
+        if (f->stage_end_hook) f->stage_end_hook(f, s, adt, f->hook_ctx);
     }
     f->time += dt;
     f->step++;
