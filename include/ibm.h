@@ -16,8 +16,10 @@
  * It works through the fluid's two stage hooks (fluid.h): at every RK3
  * stage, before the projection, the predicted velocity is forced towards the
  * rigid-body velocity U + ω × r of each sphere,
- *     u ← u + α (U − u)      (f = α (U − u*)/Δt_k),
- * with α the smoothed solid fraction of decision 1 at each staggered node;
+ *     u ← u + β (U − u)      (f = β (U − u*)/Δt_k),
+ * with α the smoothed solid fraction of decision 1 at each staggered node
+ * and β = α (the seed's forcing) or its time-step independent form
+ * β = α Δt_k/((1 − α)τ + α Δt_k) (forcing.c);
  * after the projection the momentum integrals are taken and the spheres are
  * moved.  Geometries: 3-D (spheres), 2-D (discs, per unit depth) and
  * axisymmetric (spheres on the axis, moving along it, integrals with 2πr).
@@ -70,6 +72,9 @@ typedef struct {
     double virtual_mass;  /* C_v of the added-mass stabilisation (momentum model) */
     int forcing_iterations; /* extra force + project passes per stage (0: one forcing) */
     double gravity[3];    /* acts on the particles only (pressure relative to hydrostatic) */
+    double retraction;    /* α is taken for the radius R − retraction × h (h the cell size) */
+    double forcing_time;  /* κ: partially covered nodes relax towards U with the time scale
+                           * τ = κ h²/ν (0: the seed's u ← u + α (U − u) at every stage) */
 } ibm_params_t;
 
 typedef struct ibm ibm_t;

@@ -173,14 +173,14 @@ static inline void for_box_nodes(const ibm_t *ibm, const ibm_sphere_t *s, int c,
 
 typedef struct {
     ibm_priv_t *q;
-    double R, band;
+    double R, band, retraction;
     int c;
 } build_ctx_t;
 
 static void add_node(void *ctx, long m, const int8_t img[3], const double r[3], double h)
 {
     build_ctx_t *b = ctx;
-    double rr = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]), d = rr - b->R;
+    double rr = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]), d = rr - b->R + b->retraction * h;
     if (d >= b->band * h) return;
     double a = 1.0;
     if (d > -b->band * h) {
@@ -204,7 +204,7 @@ static void add_node(void *ctx, long m, const int8_t img[3], const double r[3], 
 void ibm_build_nodes(ibm_t *ibm)
 {
     ibm_priv_t *q = ibm_priv(ibm);
-    build_ctx_t b = {.q = q, .band = ibm_band_halfwidth()};
+    build_ctx_t b = {.q = q, .band = ibm_band_halfwidth(), .retraction = ibm->prm.retraction};
     q->nnodes = 0;
     for (int p = 0; p < ibm->n; p++) {
         q->start[p] = q->nnodes;
@@ -245,14 +245,14 @@ void ibm_solid_fraction_face(const ibm_t *ibm, int c, double *out)
 
 typedef struct {
     double *out;
-    double R, band;
+    double R, band, retraction;
 } cell_ctx_t;
 
 static void add_cell(void *ctx, long m, const int8_t img[3], const double r[3], double h)
 {
     (void)img;
     cell_ctx_t *b = ctx;
-    double rr = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]), d = rr - b->R;
+    double rr = sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2]), d = rr - b->R + b->retraction * h;
     if (d >= b->band * h) return;
     double a = 1.0;
     if (d > -b->band * h) {
@@ -265,7 +265,7 @@ static void add_cell(void *ctx, long m, const int8_t img[3], const double r[3], 
 void ibm_solid_fraction_cell(const ibm_t *ibm, double *out)
 {
     field_zero(ibm->g, out);
-    cell_ctx_t b = {.out = out, .band = ibm_band_halfwidth()};
+    cell_ctx_t b = {.out = out, .band = ibm_band_halfwidth(), .retraction = ibm->prm.retraction};
     for (int p = 0; p < ibm->n; p++) {
         b.R = ibm->s[p].radius;
         for_box_nodes(ibm, &ibm->s[p], -1, add_cell, &b);

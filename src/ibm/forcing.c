@@ -60,7 +60,7 @@ static inline int node_i(const grid_t *g, long m) { return (int)(m / g->sx) - 1;
 
 /* One forcing of the current velocity; adds the impulse ∫ f dV Δt_k of each
  * sphere and its moment to sum[IBM_FIMP..]. */
-static void force_pass(ibm_t *ibm)
+static void force_pass(ibm_t *ibm, double dt)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
@@ -76,14 +76,20 @@ static void force_pass(ibm_t *ibm)
             q->aux[nd->c][nd->m] += nd->alpha * ibm_rigid_velocity(s, nd->c, r);
         }
     }
-    /* force each node once: u ← u + α (U − u); keep the impulse in aux and
+    /* force each node once: u ← u + β (U − u); keep the impulse in aux and
      * mark the node done by the sign of asum */
+    double kappa = ibm->prm.forcing_time, nu = f->prm.nu;
     for (long e = 0; e < q->nnodes; e++) {
         const ibm_node_t *nd = &q->nodes[e];
         double A = q->asum[nd->c][nd->m];
         if (A <= 0.0) continue;
+        double a = fmin(A, 1.0), beta = a;
+        if (kappa > 0 && a < 1.0) {
+            double h = q->hcell[nd->c][node_i(g, nd->m)], tau = kappa * h * h / nu;
+            beta = a * dt / ((1.0 - a) * tau + a * dt);
+        }
         double *u = &f->u[nd->c][nd->m];
-        double imp = fmin(A, 1.0) * (q->aux[nd->c][nd->m] / A - *u);
+        double imp = beta * (q->aux[nd->c][nd->m] / A - *u);
         *u += imp;
         q->aux[nd->c][nd->m] = imp;
         q->asum[nd->c][nd->m] = -A;
@@ -171,10 +177,10 @@ void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
     }
     memset(q->sum, 0, (size_t)ibm->n * IBM_NSUM * sizeof(double));
     for (int it = 0; it < ibm->prm.forcing_iterations; it++) {
-        force_pass(ibm);
+        force_pass(ibm, dt_stage);
         fluid_stage_project(f, dt_stage);
     }
-    force_pass(ibm);
+    force_pass(ibm, dt_stage);
     ibm->wall_forcing += wtime() - w0;
 }
 

@@ -29,6 +29,12 @@ static const cfg_key_t ibm_keys[] = {
     {"ibm", "gravity", CFG_VEC3, "0 0 0", -1e300, 1e300, NULL,
      "gravity acting on the free spheres (their immersed weight (ρp-ρ)V g; the fluid pressure is relative to "
      "hydrostatic)"},
+    {"ibm", "forcing_time", CFG_DOUBLE, "0", 0, 1e6, NULL,
+     "κ: a node of solid fraction α < 1 is forced by u ← u + β(U − u), β = αΔt_k/((1−α)κh²/ν + αΔt_k), whose "
+     "steady state does not depend on the time step; 0: the seed's β = α at every stage (depends on Δt)"},
+    {"ibm", "retraction", CFG_DOUBLE, "0", -1, 1, NULL,
+     "the solid fraction is that of a sphere of radius R - retraction × Δx (cells): compensates the effective "
+     "thickening of the forced sphere (0: the seed's method)"},
     {"ibm", "spheres_file", CFG_STRING, NULL, 1, 0, NULL,
      "many spheres: a CSV file (header with x,y,z,radius or diameter; optional density,u,v,w,ox,oy,oz,kind or "
      "fixed) or an HDF5 packing (.h5: datasets position [n][3], radius; optional density, velocity, omega, fixed)"},
@@ -139,7 +145,7 @@ void ibm_prescribed_velocity(const ibm_t *ibm, const ibm_sphere_t *s, double t, 
 /* ---- creation ------------------------------------------------------------------------ */
 
 /* Why sphere s does not fit grid g (NULL if it does). */
-static const char *sphere_misfit(const grid_t *g, const ibm_sphere_t *s, double rho)
+static const char *sphere_misfit(const grid_t *g, const ibm_sphere_t *s)
 {
     if (!(s->radius > 0)) return "the radius must be > 0";
     if (s->kind == IBM_FREE && !(s->density > 0)) return "a free sphere needs a density > 0";
@@ -174,7 +180,7 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
     if (n > 0) memcpy(ibm->s, s, (size_t)n * sizeof *s);
     ibm->priv = q;
     for (int p = 0; p < n; p++) {
-        const char *why = sphere_misfit(g, &ibm->s[p], f->prm.rho);
+        const char *why = sphere_misfit(g, &ibm->s[p]);
         if (why) die("immersed boundary: sphere %d: %s", p + 1, why);
         if (prm->force_model == IBM_FORCE_RIGID && ibm->s[p].kind == IBM_FREE &&
             fabs(ibm->s[p].density - f->prm.rho) < 1e-12 * f->prm.rho)
@@ -182,13 +188,18 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
                 "momentum)",
                 p + 1);
         if (ibm->s[p].kind != IBM_PRESCRIBED) ibm->s[p].history = -1;
+        if (g->dim == 2) ibm->s[p].x[2] = 0.0;
     }
     for (int c = 0; c < g->dim; c++) {
         q->asum[c] = field_alloc(g);
         q->aux[c] = field_alloc(g);
         q->vol[c] = (double *)xcalloc((size_t)g->nxl + 2, sizeof(double)) + 1;
-        for (int i = 0; i < g->nxl; i++)
+        q->hcell[c] = (double *)xcalloc((size_t)g->nxl + 2, sizeof(double)) + 1;
+        for (int i = 0; i < g->nxl; i++) {
             q->vol[c][i] = fluid_cell_volume(f, c, i) * (g->geom == GEOM_AXI ? 2.0 * M_PI : 1.0);
+            double hx = c == 0 ? g->dxc[i] : g->dxf[i];
+            q->hcell[c][i] = g->dim == 3 ? cbrt(hx * g->dy * g->dz) : sqrt(hx * g->dy);
+        }
     }
     size_t nn = (size_t)(n > 0 ? n : 1);
     q->start = xcalloc(nn + 1, sizeof(long));
@@ -215,6 +226,7 @@ void ibm_free(ibm_t *ibm)
         free(q->asum[c]);
         free(q->aux[c]);
         if (q->vol[c]) free(q->vol[c] - 1);
+        if (q->hcell[c]) free(q->hcell[c] - 1);
     }
     for (int h = 0; h < q->nhist; h++) {
         free(q->hist[h].t);
@@ -464,6 +476,8 @@ ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f)
     prm.virtual_mass = cfg_double(cfg, "ibm", "virtual_mass");
     prm.forcing_iterations = cfg_int(cfg, "ibm", "forcing_iterations");
     cfg_vec3(cfg, "ibm", "gravity", prm.gravity);
+    prm.retraction = cfg_double(cfg, "ibm", "retraction");
+    prm.forcing_time = cfg_double(cfg, "ibm", "forcing_time");
     if (g->geom == GEOM_AXI && (prm.gravity[0] != 0.0 || prm.gravity[2] != 0.0))
         cfg_fail(cfg, "ibm", "gravity", "an axisymmetric gravity must be axial (y)");
     if (g->dim == 2 && prm.gravity[2] != 0.0) cfg_fail(cfg, "ibm", "gravity", "a 2-D grid has no z direction");
@@ -479,7 +493,7 @@ ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f)
         s = realloc(s, (size_t)(n + 1) * sizeof *s);
         char h[1024];
         parse_sphere(cfg, key, cfg_string(cfg, "ibm", key), &s[n], h, sizeof h);
-        const char *why = sphere_misfit(g, &s[n], f->prm.rho);
+        const char *why = sphere_misfit(g, &s[n]);
         if (why) cfg_fail(cfg, "ibm", key, "%s", why);
         if (h[0]) {
             snprintf(hist[nh], sizeof hist[nh], "%s", h);
@@ -503,7 +517,7 @@ ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f)
                 cfg_fail(cfg, "ibm", cfg_has(cfg, "ibm", "density") ? "density" : "spheres_file",
                          "sphere %d of %s is free and has no density > 0 (give a density column or [ibm] density)",
                          p - n0 + 1, path);
-            const char *why = sphere_misfit(g, &s[p], f->prm.rho);
+            const char *why = sphere_misfit(g, &s[p]);
             if (why) cfg_fail(cfg, "ibm", "spheres_file", "sphere %d of %s: %s", p - n0 + 1, path, why);
         }
     }

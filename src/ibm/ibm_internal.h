@@ -36,6 +36,7 @@ typedef struct {
     /* control volume of each unknown by local x index (−1..nxl), times 2π
      * in axisymmetric geometry: the integrals are over the whole volume */
     double *vol[3];
+    double *hcell[3];  /* cell size h of the unknowns by local x index (see alpha.c) */
     /* per-sphere sums: forcing impulse ∫f dV Δt_k and its moment, fluid
      * momentum ∫α u dV and angular momentum ∫α r × u dV */
     double *sum;       /* n × IBM_NSUM, this rank, then reduced */

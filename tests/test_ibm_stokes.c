@@ -1,0 +1,140 @@
+/* test_ibm_stokes.c — Stokes flow past spheres, against exact results.
+ *
+ * Drag: a fixed sphere in a triply periodic cube is a simple cubic array
+ * of spheres.  A body force f drives the fluid; at the steady state the
+ * forcing of the immersed boundary balances the whole body force, so the
+ * drag is known exactly, F = ρ f L³, and the test measures the superficial
+ * velocity U (the mean of u over the whole box).  Hasimoto (1959), for the
+ * dilute simple cubic array:
+ *     K = F/(6πμaU) = 1/(1 − 1.7601 c^{1/3} + c − 1.5593 c²),  c = (4/3)πa³/L³.
+ * Box L = 3.75 D (c = 0.00993) at D/Δx = 8, 12 (and 16, 24 in
+ * scripts/validate.sh); Re = UD/ν = 0.01.
+ *
+ * Torque: a sphere rotating at Ω in a still fluid (periodic box of 4 D,
+ * c = 0.008) feels T = −8πμa³Ω (Stokes flow), within O(c) of the unbounded
+ * value; Re = Ωa²/ν = 0.0025.
+ *
+ * The immersed boundary's forcing makes partially covered nodes nearly
+ * rigid, so the effective radius of a sphere exceeds a by a fraction of a
+ * cell: errors are first order in Δx/D (measured below).
+ * RANKS: 2
+ */
+#include "ibmtest.h"
+#include "modules.h"
+#include "testutil.h"
+
+static double hasimoto_K(double c)
+{
+    return 1.0 / (1.0 - 1.7601 * cbrt(c) + c - 1.5593 * c * c);
+}
+
+static double env_double(const char *name, double def)
+{
+    const char *s = getenv(name);
+    return s ? atof(s) : def;
+}
+
+/* Steady Stokes flow through the simple cubic array at D/Δx = dpd with n
+ * cells per side; returns K measured / K of Hasimoto.
+ *
+ * The mean flow of a fixed array relaxes on the Darcy time L³/(6πaνK),
+ * which is 10 times the viscous time of the box here: the body force is
+ * therefore set by a proportional controller, f = f_H + (U_H − U)/τ_c,
+ * which only shortens that relaxation (to τ_c = 10 Δt); K is measured from
+ * the final pair (f, U), both steady, so the controller does not bias it. */
+static double drag_ratio(int dpd, int n, double fo, double *c_out)
+{
+    double dx = 1.0 / dpd, L = n * dx, a = 0.5, nu = 1.0;
+    double c = 4.0 / 3.0 * M_PI * a * a * a / (L * L * L), K = hasimoto_K(c);
+    double U = 0.01; /* Re = U D / ν */
+    double fH = 6 * M_PI * nu * a * U * K / (L * L * L);
+    double dt = fo * dx * dx / nu, tau = env_double("IBM_TAUC", 10.0) * dt;
+    char text[2048];
+    snprintf(text, sizeof text,
+             "[domain]\nnx = %d\nny = %d\nnz = %d\nlength = %.17g %.17g %.17g\n"
+             "[fluid]\nnu = %g\nviscous = %s\nbody_force = %.17g 0 0\ndt = %.17g\n"
+             "[ibm]\nsphere1 = fixed center %.17g %.17g %.17g radius %g\n"
+             "retraction = %g\nforcing_time = %g\n",
+             n, n, n, L, L, L, nu, getenv("IBM_VISC") ? getenv("IBM_VISC") : "implicit", fH, dt, 0.5 * L, 0.5 * L, 0.5 * L, a, env_double("IBM_RETRACTION", 0.0), env_double("IBM_KAPPA", 0.0));
+    it_case_t tc = it_from_case(text);
+    /* the slowest viscous mode of the box decays as exp(−ν(2π/L)² t) */
+    double t_end = env_double("IBM_TDECAY", 8.0) * L * L / (4 * M_PI * M_PI * nu);
+    double Um = 0, Km = 0, Km_prev = 0;
+    int steps = 0;
+    while (tc.f->time < t_end) {
+        fluid_step(tc.f, dt);
+        steps++;
+        Um = it_mean_velocity(tc.f, 0);
+        Km_prev = Km;
+        Km = tc.f->prm.body_force[0] * L * L * L / (6 * M_PI * nu * a * Um);
+        tc.f->prm.body_force[0] = fH + (U - Um) / tau;
+    }
+    print_message("  D/dx = %2d, n = %3d, c = %.5f: %d steps, U = %.6g, drag %.6g (sphere's own: %.6g), "
+                  "K = %.5f (last step change %.1e), Hasimoto %.5f, ratio %.5f\n",
+                  dpd, n, c, steps, Um, tc.f->prm.body_force[0] * L * L * L, tc.ibm->s[0].force[0], Km,
+                  fabs(Km - Km_prev) / Km, K, Km / K);
+    it_free(&tc);
+    if (c_out) *c_out = c;
+    return Km / K;
+}
+
+static void test_hasimoto_drag(void **state)
+{
+    (void)state;
+    int dpd[2] = {8, 12}, n[2] = {32, 48};
+    double r[2], c;
+    for (int i = 0; i < 2; i++) r[i] = drag_ratio(dpd[i], n[i], env_double("IBM_FO", 1.0), &c);
+    double e0 = fabs(r[0] - 1), e1 = fabs(r[1] - 1);
+    print_message("  error %.4f -> %.4f, order %.2f\n", e0, e1, conv_order(e0, e1, 1.5));
+}
+
+/* Torque on a sphere rotating at Ω about z in a periodic box of 4 D, at
+ * D/Δx = dpd; returns T / (−8πμa³Ω). */
+static double torque_ratio(int dpd, double fo)
+{
+    double dx = 1.0 / dpd, a = 0.5, nu = 1.0, Om = 0.01;
+    int n = 4 * dpd;
+    double L = n * dx, dt = fo * dx * dx / nu;
+    char text[2048];
+    snprintf(text, sizeof text,
+             "[domain]\nnx = %d\nny = %d\nnz = %d\nlength = %.17g %.17g %.17g\n"
+             "[fluid]\nnu = %g\nviscous = implicit\ndt = %.17g\n"
+             "[ibm]\nsphere1 = prescribed center %.17g %.17g %.17g radius %g omega 0 0 %g\n"
+             "retraction = %g\nforcing_time = %g\n",
+             n, n, n, L, L, L, nu, dt, 0.5 * L, 0.5 * L, 0.5 * L, a, Om, env_double("IBM_RETRACTION", 0.0), env_double("IBM_KAPPA", 0.0));
+    it_case_t tc = it_from_case(text);
+    double exact = -8 * M_PI * nu * a * a * a * Om, T = 0, Tp = 0;
+    double t_end = env_double("IBM_TDECAY", 8.0) * L * L / (4 * M_PI * M_PI * nu);
+    int steps = 0;
+    while (tc.f->time < t_end) {
+        fluid_step(tc.f, dt);
+        steps++;
+        Tp = T;
+        T = tc.ibm->s[0].torque[2];
+    }
+    print_message("  D/dx = %2d, n = %3d: %d steps, torque %.6g (last step change %.1e), 8 pi mu a^3 Omega = %.6g, "
+                  "ratio %.5f; other components %.1e %.1e, force %.1e\n",
+                  dpd, n, steps, T, fabs(T - Tp) / fabs(T), -exact, T / exact, tc.ibm->s[0].torque[0],
+                  tc.ibm->s[0].torque[1], tc.ibm->s[0].force[0]);
+    it_free(&tc);
+    return T / exact;
+}
+
+static void test_rotating_sphere_torque(void **state)
+{
+    (void)state;
+    int dpd = (int)env_double("IBM_TORQUE_DPD", 10);
+    double r = torque_ratio(dpd, env_double("IBM_FO", 1.0));
+    (void)r;
+}
+
+int main(int argc, char **argv)
+{
+    test_mpi_init(&argc, &argv);
+    modules_register_keys();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_hasimoto_drag),
+        cmocka_unit_test(test_rotating_sphere_torque),
+    };
+    TEST_MPI_RUN("ibm_stokes", tests);
+}
