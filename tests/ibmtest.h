@@ -73,7 +73,7 @@ static inline double it_schiller_naumann(double D, double rho_ratio, double g, d
     for (int it = 0; it < 200; it++) {
         double u = 0.5 * (lo + hi), Re = u * D / nu;
         double cd = 24.0 / Re * (1.0 + 0.15 * pow(Re, 0.687));
-        if (cd * M_PI * D * D / 8.0 * u * u > (rho_ratio - 1.0) * M_PI * D * D * D / 6.0 * g)
+        if (cd * M_PI * D * D / 8.0 * u * u > fabs(rho_ratio - 1.0) * M_PI * D * D * D / 6.0 * g)
             hi = u;
         else
             lo = u;
