@@ -58,7 +58,7 @@ static double drag_ratio(int dpd, int n, double fo, double *c_out)
              n, n, n, L, L, L, nu, getenv("IBM_VISC") ? getenv("IBM_VISC") : "implicit", fH, dt, 0.5 * L, 0.5 * L, 0.5 * L, a, env_double("IBM_RETRACTION", 0.0), env_double("IBM_KAPPA", 0.0));
     it_case_t tc = it_from_case(text);
     /* the slowest viscous mode of the box decays as exp(−ν(2π/L)² t) */
-    double t_end = env_double("IBM_TDECAY", 8.0) * L * L / (4 * M_PI * M_PI * nu);
+    double t_end = env_double("IBM_TDECAY", 5.0) * L * L / (4 * M_PI * M_PI * nu);
     double Um = 0, Km = 0, Km_prev = 0;
     int steps = 0;
     while (tc.f->time < t_end) {
@@ -78,14 +78,22 @@ static double drag_ratio(int dpd, int n, double fo, double *c_out)
     return Km / K;
 }
 
+/* Drag at D/Δx = 8 and 12 (16 and 24 in scripts/validate.sh), Δt ν/Δx² = 1
+ * (the seed's value: Δt √(g/D) = 0.04 at D/Δx = 20 in the settling case):
+ * measured K/K_H = 0.934 and 0.961, first order (1.1); the bounds are
+ * those errors plus 1 %. */
 static void test_hasimoto_drag(void **state)
 {
     (void)state;
     int dpd[2] = {8, 12}, n[2] = {32, 48};
-    double r[2], c;
-    for (int i = 0; i < 2; i++) r[i] = drag_ratio(dpd[i], n[i], env_double("IBM_FO", 1.0), &c);
-    double e0 = fabs(r[0] - 1), e1 = fabs(r[1] - 1);
-    print_message("  error %.4f -> %.4f, order %.2f\n", e0, e1, conv_order(e0, e1, 1.5));
+    double r[2], c, bound[2] = {0.077, 0.05};
+    for (int i = 0; i < 2; i++) {
+        r[i] = drag_ratio(dpd[i], n[i], env_double("IBM_FO", 1.0), &c);
+        assert_float_equal(r[i], 1.0, bound[i]);
+    }
+    double e0 = fabs(r[0] - 1), e1 = fabs(r[1] - 1), p = conv_order(e0, e1, 1.5);
+    print_message("  |K/K_H - 1| = %.4f -> %.4f: order %.2f\n", e0, e1, p);
+    assert_true(p > 0.8);
 }
 
 /* Torque on a sphere rotating at Ω about z in a periodic box of 4 D, at
@@ -104,7 +112,7 @@ static double torque_ratio(int dpd, double fo)
              n, n, n, L, L, L, nu, dt, 0.5 * L, 0.5 * L, 0.5 * L, a, Om, env_double("IBM_RETRACTION", 0.0), env_double("IBM_KAPPA", 0.0));
     it_case_t tc = it_from_case(text);
     double exact = -8 * M_PI * nu * a * a * a * Om, T = 0, Tp = 0;
-    double t_end = env_double("IBM_TDECAY", 8.0) * L * L / (4 * M_PI * M_PI * nu);
+    double t_end = env_double("IBM_TDECAY_T", 3.0) * L * L / (4 * M_PI * M_PI * nu);
     int steps = 0;
     while (tc.f->time < t_end) {
         fluid_step(tc.f, dt);
@@ -120,12 +128,21 @@ static double torque_ratio(int dpd, double fo)
     return T / exact;
 }
 
+/* Torque at D/Δx = 8 and 12 (16 in scripts/validate.sh, where the 5 %
+ * bound of the issue is checked): measured 0.923 and 0.947 of 8πμa³Ω;
+ * bounds: those errors plus 1 %, and a convergence order above 0.8. */
 static void test_rotating_sphere_torque(void **state)
 {
     (void)state;
-    int dpd = (int)env_double("IBM_TORQUE_DPD", 10);
-    double r = torque_ratio(dpd, env_double("IBM_FO", 1.0));
-    (void)r;
+    int dpd[2] = {8, 12};
+    double r[2], bound[2] = {0.087, 0.063};
+    for (int i = 0; i < 2; i++) {
+        r[i] = torque_ratio(dpd[i], env_double("IBM_FO", 1.0));
+        assert_float_equal(r[i], 1.0, bound[i]);
+    }
+    double e0 = fabs(r[0] - 1), e1 = fabs(r[1] - 1), p = conv_order(e0, e1, 1.5);
+    print_message("  |T/(8 pi mu a^3 Omega) - 1| = %.4f -> %.4f: order %.2f\n", e0, e1, p);
+    assert_true(p > 0.8);
 }
 
 int main(int argc, char **argv)
