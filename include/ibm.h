@@ -89,6 +89,7 @@ struct ibm {
      * integrals, particle update) since creation */
     double wall_alpha, wall_forcing, wall_integrals;
     long nodes_forced;     /* node entries (sphere, node) of the last stage, this rank */
+    long nodes_shared;     /* ... of them in runs that another sphere's band may reach */
     void *priv;
 };
 
@@ -102,7 +103,8 @@ ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f);
 
 /* ---- programmatic use (tests, coupling) -------------------------------------- */
 
-/* Default parameters (momentum model, C_v = 0.5, no iterations, no gravity). */
+/* Default parameters (momentum model, C_v = 0.1, the seed's forcing, no
+ * iterations, no retraction, no gravity). */
 ibm_params_t ibm_default_params(void);
 /* Build for the fluid f with n spheres (copied) and install the stage hooks
  * (f->stage_hook, f->stage_end_hook).  Dies on spheres that do not fit the

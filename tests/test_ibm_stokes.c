@@ -7,16 +7,17 @@
  * velocity U (the mean of u over the whole box).  Hasimoto (1959), for the
  * dilute simple cubic array:
  *     K = F/(6πμaU) = 1/(1 − 1.7601 c^{1/3} + c − 1.5593 c²),  c = (4/3)πa³/L³.
- * Box L = 3.75 D (c = 0.00993) at D/Δx = 8, 12 (and 16, 24 in
+ * Box L = 4 D (c = 0.00818) at D/Δx = 8, 12 (and 16, 24 in
  * scripts/validate.sh); Re = UD/ν = 0.01.
  *
  * Torque: a sphere rotating at Ω in a still fluid (periodic box of 4 D,
  * c = 0.008) feels T = −8πμa³Ω (Stokes flow), within O(c) of the unbounded
  * value; Re = Ωa²/ν = 0.0025.
  *
- * The immersed boundary's forcing makes partially covered nodes nearly
- * rigid, so the effective radius of a sphere exceeds a by a fraction of a
- * cell: errors are first order in Δx/D (measured below).
+ * The forced band of partially covered nodes (about 2.5 cells) sets an
+ * effective radius that differs from a by a fraction of a cell, which
+ * depends on Δt ν/Δx² with the seed's forcing (docs/theory.md §6b): the
+ * errors are first order in Δx/D (measured below) at Δt ν/Δx² = 1.
  * RANKS: 2
  */
 #include "ibmtest.h"
@@ -85,15 +86,19 @@ static double drag_ratio(int dpd, int n, double fo, double *c_out)
 static void test_hasimoto_drag(void **state)
 {
     (void)state;
-    int dpd[2] = {8, 12}, n[2] = {32, 48};
-    double r[2], c, bound[2] = {0.077, 0.05};
-    for (int i = 0; i < 2; i++) {
-        r[i] = drag_ratio(dpd[i], n[i], env_double("IBM_FO", 1.0), &c);
+    /* IBM_FULL=1 (scripts/validate.sh): D/Δx = 8, 12, 16, 24 */
+    int full = getenv("IBM_FULL") != NULL, nl = full ? 4 : 2;
+    int dpd[4] = {8, 12, 16, 24};
+    double r[4], c, bound[4] = {0.077, 0.05, 0.04, 0.03};
+    for (int i = 0; i < nl; i++) {
+        r[i] = drag_ratio(dpd[i], 4 * dpd[i], env_double("IBM_FO", 1.0), &c);
         assert_float_equal(r[i], 1.0, bound[i]);
     }
-    double e0 = fabs(r[0] - 1), e1 = fabs(r[1] - 1), p = conv_order(e0, e1, 1.5);
-    print_message("  |K/K_H - 1| = %.4f -> %.4f: order %.2f\n", e0, e1, p);
-    assert_true(p > 0.8);
+    for (int i = 0; i + 1 < nl; i++) {
+        double e0 = fabs(r[i] - 1), e1 = fabs(r[i + 1] - 1), p = conv_order(e0, e1, (double)dpd[i + 1] / dpd[i]);
+        print_message("  |K/K_H - 1| = %.4f (D/dx = %d) -> %.4f (%d): order %.2f\n", e0, dpd[i], e1, dpd[i + 1], p);
+        assert_true(p > 0.8);
+    }
 }
 
 /* Torque on a sphere rotating at Ω about z in a periodic box of 4 D, at
@@ -134,15 +139,20 @@ static double torque_ratio(int dpd, double fo)
 static void test_rotating_sphere_torque(void **state)
 {
     (void)state;
-    int dpd[2] = {8, 12};
-    double r[2], bound[2] = {0.087, 0.063};
-    for (int i = 0; i < 2; i++) {
+    /* IBM_FULL=1: also D/Δx = 16, where the 5 % applies */
+    int full = getenv("IBM_FULL") != NULL, nl = full ? 3 : 2;
+    int dpd[3] = {8, 12, 16};
+    double r[3], bound[3] = {0.087, 0.063, 0.05};
+    for (int i = 0; i < nl; i++) {
         r[i] = torque_ratio(dpd[i], env_double("IBM_FO", 1.0));
         assert_float_equal(r[i], 1.0, bound[i]);
     }
-    double e0 = fabs(r[0] - 1), e1 = fabs(r[1] - 1), p = conv_order(e0, e1, 1.5);
-    print_message("  |T/(8 pi mu a^3 Omega) - 1| = %.4f -> %.4f: order %.2f\n", e0, e1, p);
-    assert_true(p > 0.8);
+    for (int i = 0; i + 1 < nl; i++) {
+        double e0 = fabs(r[i] - 1), e1 = fabs(r[i + 1] - 1), p = conv_order(e0, e1, (double)dpd[i + 1] / dpd[i]);
+        print_message("  |T/(8 pi mu a^3 Omega) - 1| = %.4f (D/dx = %d) -> %.4f (%d): order %.2f\n", e0, dpd[i], e1,
+                      dpd[i + 1], p);
+        assert_true(p > 0.8);
+    }
 }
 
 int main(int argc, char **argv)

@@ -30,12 +30,17 @@
  *     (m_p + C_v ρ V_p) Δu = J + (ρ_p − ρ) V_p g Δt_k + C_v ρ V_p Δu_prev,
  *     (I_p + C_v (ρ/ρ_p) I_p) Δω = K + C_v (ρ/ρ_p) I_p Δω_prev,
  *     x^k = x^{k−1} + Δt_k (u^{k−1} + Δu/2)     (X^k − x^k = O(Δt_k² du/dt)),
- *  where the C_v terms are the virtual-mass stabilisation of Schwarz,
- *  Kempe & Fröhlich (2015): the explicit coupling feels the fluid's
- *  reaction (added mass) to the velocity change of the previous stage, and
- *  is unstable when that reaction exceeds the particle's inertia (ρ_p/ρ
- *  below about 1); adding C_v ρ V_p (Δu − Δu_prev) leaves every steady
- *  state unchanged and makes light particles stable (docs/theory.md §6b).
+ *  where the C_v terms stabilise light spheres (virtual mass, Schwarz,
+ *  Kempe & Fröhlich 2015) without changing any steady state.  Why: the
+ *  explicit coupling measures the fluid's reaction to the velocity jumps
+ *  of the previous stages — the projection keeps about 2/3 of a jump
+ *  imposed inside a sphere and returns 1/3 as a pressure impulse, measured
+ *  at the next stage, and so on (a geometric series of ratio 1/3 whose sum
+ *  is the added mass ½ρV).  With that response the stage-to-stage
+ *  amplification z of the plain coupling is (1 − ρ/ρ_p)/3: unstable below
+ *  ρ_p/ρ = 1/4 (measured: 0.3 runs, 0.2 diverges).  With C_v = c and
+ *  r = ρ_p/ρ, 3(r + c)z² + (1 − r − 4c)z + c = 0: c = 0.1 keeps |z| ≤ 0.33
+ *  for r ≥ 0.2 and |z| < 1 down to r ≈ 0.05 (docs/theory.md §6b).
  *  The seed's rigid-body model (force_model = rigid, eq. 2.32) instead
  *  assumes the fluid inside moves rigidly:
  *     Δu = g Δt_k − ρ ∫ f dV Δt_k / ((ρ_p − ρ) V_p).
@@ -56,61 +61,107 @@ static inline void cross_axis(const double r[3], int c, double a, double out[3])
     }
 }
 
-static inline int node_i(const grid_t *g, long m) { return (int)(m / g->sx) - 1; }
+/* β of a node of solid fraction a (see ibm.h): the seed's β = α, or the
+ * implicit relaxation over the stage with the time scale τ = κ h²/ν. */
+static inline double forcing_beta(double a, double dt, double tau)
+{
+    if (tau <= 0.0 || a >= 1.0) return a;
+    return a * dt / ((1.0 - a) * tau + a * dt);
+}
 
 /* One forcing of the current velocity; adds the impulse ∫ f dV Δt_k of each
- * sphere and its moment to sum[IBM_FIMP..]. */
+ * sphere and its moment to sum[IBM_FIMP..].  A run that no other sphere's
+ * band reaches (run->shared = 0, alpha.c) is forced directly; the shared
+ * runs go through the dense scratch, where a node takes α = min(1, Σα_p),
+ * the α-weighted mean velocity, and each sphere the share α_p/Σα of its
+ * impulse. */
 static void force_pass(ibm_t *ibm, double dt)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
     fluid_t *f = ibm->f;
-    double r[3];
-    /* Σ α_p and Σ α_p U_p at every node */
+    double kappa = ibm->prm.forcing_time, nu = f->prm.nu, step = q->rstep;
+    long st = q->rstride;
+    int rd = q->rdir, shared = 0;
     for (int p = 0; p < ibm->n; p++) {
         const ibm_sphere_t *s = &ibm->s[p];
-        for (long e = q->start[p]; e < q->start[p + 1]; e++) {
-            const ibm_node_t *nd = &q->nodes[e];
-            ibm_node_offset(ibm, nd, s, r);
-            q->asum[nd->c][nd->m] += nd->alpha;
-            q->aux[nd->c][nd->m] += nd->alpha * ibm_rigid_velocity(s, nd->c, r);
+        double *sum = q->sum + (long)p * IBM_NSUM, J[3] = {0, 0, 0}, T[3] = {0, 0, 0};
+        for (long ir = q->start[p]; ir < q->start[p + 1]; ir++) {
+            const ibm_run_t *run = &q->runs[ir];
+            int c = run->c;
+            if (run->shared) {
+                /* Σ α_p and Σ α_p U_p for the shared pass below */
+                double *A = q->asum[c] + run->m0, *B = q->aux[c] + run->m0, r[3] = {run->r0[0], run->r0[1], run->r0[2]};
+                for (int k = 0; k < run->len; k++, r[rd] += step) {
+                    double a = q->alpha[run->a0 + k];
+                    A[k * st] += a;
+                    B[k * st] += a * ibm_rigid_velocity(s, c, r);
+                }
+                shared = 1;
+                continue;
+            }
+            int i = ibm_node_i(g, run->m0);
+            double *u = f->u[c] + run->m0;
+            const double *al = q->alpha + run->a0;
+            double h = q->hcell[c][i], tau = kappa > 0 ? kappa * h * h / nu : 0.0, vol = q->vol[c][i];
+            double r[3] = {run->r0[0], run->r0[1], run->r0[2]}, jr = 0, t[3];
+            for (int k = 0; k < run->len; k++, r[rd] += step) {
+                double imp = forcing_beta(al[k], dt, tau) * (ibm_rigid_velocity(s, c, r) - u[k * st]);
+                u[k * st] += imp;
+                jr += imp;
+                cross_axis(r, c, imp, t);
+                for (int d = 0; d < 3; d++) T[d] += t[d] * vol;
+            }
+            J[c] += jr * vol;
+        }
+        for (int d = 0; d < 3; d++) {
+            sum[IBM_FIMP + d] += J[d];
+            sum[IBM_TIMP + d] += T[d];
         }
     }
-    /* force each node once: u ← u + β (U − u); keep the impulse in aux and
-     * mark the node done by the sign of asum */
-    double kappa = ibm->prm.forcing_time, nu = f->prm.nu;
-    for (long e = 0; e < q->nnodes; e++) {
-        const ibm_node_t *nd = &q->nodes[e];
-        double A = q->asum[nd->c][nd->m];
-        if (A <= 0.0) continue;
-        double a = fmin(A, 1.0), beta = a;
-        if (kappa > 0 && a < 1.0) {
-            double h = q->hcell[nd->c][node_i(g, nd->m)], tau = kappa * h * h / nu;
-            beta = a * dt / ((1.0 - a) * tau + a * dt);
+    if (!shared) return;
+    /* force each shared node once (u ← u + β (U − u)); keep the impulse in
+     * aux and mark the node done by the sign of asum */
+    for (long ir = 0; ir < q->nruns; ir++) {
+        const ibm_run_t *run = &q->runs[ir];
+        if (!run->shared) continue;
+        int c = run->c, i = ibm_node_i(g, run->m0);
+        double h = q->hcell[c][i], tau = kappa > 0 ? kappa * h * h / nu : 0.0;
+        double *A = q->asum[c] + run->m0, *B = q->aux[c] + run->m0, *u = f->u[c] + run->m0;
+        for (int k = 0; k < run->len; k++) {
+            double Ak = A[k * st];
+            if (Ak <= 0.0) continue;
+            double imp = forcing_beta(Ak < 1.0 ? Ak : 1.0, dt, tau) * (B[k * st] / Ak - u[k * st]);
+            u[k * st] += imp;
+            B[k * st] = imp;
+            A[k * st] = -Ak;
         }
-        double *u = &f->u[nd->c][nd->m];
-        double imp = beta * (q->aux[nd->c][nd->m] / A - *u);
-        *u += imp;
-        q->aux[nd->c][nd->m] = imp;
-        q->asum[nd->c][nd->m] = -A;
     }
     /* each sphere's share α_p/Σα of the impulse, and its moment */
     for (int p = 0; p < ibm->n; p++) {
-        const ibm_sphere_t *s = &ibm->s[p];
         double *sum = q->sum + (long)p * IBM_NSUM, t[3];
-        for (long e = q->start[p]; e < q->start[p + 1]; e++) {
-            const ibm_node_t *nd = &q->nodes[e];
-            double J = nd->alpha / -q->asum[nd->c][nd->m] * q->aux[nd->c][nd->m] * q->vol[nd->c][node_i(g, nd->m)];
-            sum[IBM_FIMP + nd->c] += J;
-            ibm_node_offset(ibm, nd, s, r);
-            cross_axis(r, nd->c, J, t);
-            for (int d = 0; d < 3; d++) sum[IBM_TIMP + d] += t[d];
+        for (long ir = q->start[p]; ir < q->start[p + 1]; ir++) {
+            const ibm_run_t *run = &q->runs[ir];
+            if (!run->shared) continue;
+            int c = run->c;
+            double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]};
+            const double *A = q->asum[c] + run->m0, *B = q->aux[c] + run->m0;
+            for (int k = 0; k < run->len; k++, r[rd] += step) {
+                if (A[k * st] >= 0.0) continue; /* α = 0 at the end of a run: not forced */
+                double J = q->alpha[run->a0 + k] / -A[k * st] * B[k * st] * vol;
+                sum[IBM_FIMP + c] += J;
+                cross_axis(r, c, J, t);
+                for (int d = 0; d < 3; d++) sum[IBM_TIMP + d] += t[d];
+            }
         }
     }
-    for (long e = 0; e < q->nnodes; e++) {
-        const ibm_node_t *nd = &q->nodes[e];
-        q->asum[nd->c][nd->m] = 0.0;
-        q->aux[nd->c][nd->m] = 0.0;
+    for (long ir = 0; ir < q->nruns; ir++) {
+        const ibm_run_t *run = &q->runs[ir];
+        if (!run->shared) continue;
+        for (int k = 0; k < run->len; k++) {
+            q->asum[run->c][run->m0 + k * st] = 0.0;
+            q->aux[run->c][run->m0 + k * st] = 0.0;
+        }
     }
 }
 
@@ -120,18 +171,26 @@ void ibm_momentum(ibm_t *ibm, double *sum_all)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
-    double r[3], t[3];
+    long st = q->rstride;
+    int rd = q->rdir;
     for (int p = 0; p < ibm->n; p++) {
-        const ibm_sphere_t *s = &ibm->s[p];
-        double *sum = sum_all + (long)p * IBM_NSUM;
-        for (int d = 0; d < 6; d++) sum[IBM_MOM + d] = 0.0;
-        for (long e = q->start[p]; e < q->start[p + 1]; e++) {
-            const ibm_node_t *nd = &q->nodes[e];
-            double a = nd->alpha * ibm->f->u[nd->c][nd->m] * q->vol[nd->c][node_i(g, nd->m)];
-            sum[IBM_MOM + nd->c] += a;
-            ibm_node_offset(ibm, nd, s, r);
-            cross_axis(r, nd->c, a, t);
-            for (int d = 0; d < 3; d++) sum[IBM_ANG + d] += t[d];
+        double *sum = sum_all + (long)p * IBM_NSUM, I[3] = {0, 0, 0}, Lm[3] = {0, 0, 0}, t[3];
+        for (long ir = q->start[p]; ir < q->start[p + 1]; ir++) {
+            const ibm_run_t *run = &q->runs[ir];
+            int c = run->c;
+            const double *u = ibm->f->u[c] + run->m0, *al = q->alpha + run->a0;
+            double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]}, s = 0;
+            for (int k = 0; k < run->len; k++, r[rd] += q->rstep) {
+                double a = al[k] * u[k * st];
+                s += a;
+                cross_axis(r, c, a * vol, t);
+                for (int d = 0; d < 3; d++) Lm[d] += t[d];
+            }
+            I[c] += s * vol;
+        }
+        for (int d = 0; d < 3; d++) {
+            sum[IBM_MOM + d] = I[d];
+            sum[IBM_ANG + d] = Lm[d];
         }
     }
 }

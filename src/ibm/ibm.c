@@ -21,9 +21,9 @@ static const cfg_key_t ibm_keys[] = {
     {"ibm", "force_model", CFG_ENUM, "momentum", 1, 0, "momentum|rigid",
      "hydrodynamic force: forcing integral + rate of change of the fluid momentum inside the sphere "
      "(momentum: any density ratio), or the seed's rigid-body formula -ρρp/(ρp-ρ)∫f dV (rigid: ρp/ρ well above 1)"},
-    {"ibm", "virtual_mass", CFG_DOUBLE, "0.5", 0, 10, NULL,
-     "momentum model: C_v of the added-mass stabilisation (m + C_v ρ V) Δu = ... + C_v ρ V Δu_previous; 0.5 is the "
-     "added mass of a sphere (0: plain explicit coupling, unstable for light spheres)"},
+    {"ibm", "virtual_mass", CFG_DOUBLE, "0.1", 0, 10, NULL,
+     "momentum model: C_v of the stabilisation (m + C_v ρ V) Δu = ... + C_v ρ V Δu_previous (0: plain explicit "
+     "coupling, unstable below ρp/ρ = 0.25; 0.1: stable down to about 0.05, see docs/theory.md)"},
     {"ibm", "forcing_iterations", CFG_INT, "0", 0, 20, NULL,
      "extra (force, project) passes per Runge-Kutta stage before the final forcing (each costs a pressure solve)"},
     {"ibm", "gravity", CFG_VEC3, "0 0 0", -1e300, 1e300, NULL,
@@ -53,7 +53,7 @@ ibm_params_t ibm_default_params(void)
     ibm_params_t p;
     memset(&p, 0, sizeof p);
     p.force_model = IBM_FORCE_MOMENTUM;
-    p.virtual_mass = 0.5;
+    p.virtual_mass = 0.1;
     return p;
 }
 
@@ -203,6 +203,10 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
     }
     size_t nn = (size_t)(n > 0 ? n : 1);
     q->start = xcalloc(nn + 1, sizeof(long));
+    q->nb_start = xcalloc(nn + 1, sizeof(int));
+    q->rdir = g->dim == 3 ? 2 : 1;
+    q->rstride = g->dim == 3 ? 1 : g->sy;
+    q->rstep = g->dim == 3 ? g->dz : g->dy;
     q->sum = xcalloc(nn * IBM_NSUM, sizeof(double));
     q->mom_prev = xcalloc(nn * 6, sizeof(double));
     q->imp_step = xcalloc(nn * 6, sizeof(double));
@@ -233,7 +237,10 @@ void ibm_free(ibm_t *ibm)
         free(q->hist[h].v);
     }
     free(q->hist);
-    free(q->nodes);
+    free(q->runs);
+    free(q->alpha);
+    free(q->nb);
+    free(q->nb_start);
     free(q->start);
     free(q->sum);
     free(q->mom_prev);

@@ -7,14 +7,20 @@
 
 #include "ibm.h"
 
-/* One (sphere, velocity node) pair with α > 0 on this rank. */
+/* A run of consecutive nodes of one velocity component inside the band
+ * or the interior of one sphere, along the fastest storage direction (z in
+ * 3-D, y in 2-D): node q = 0..len−1 is at storage index m0 + q·stride, at
+ * offset r0 + q·h_run e_run from the sphere's centre (periodic image
+ * applied), with solid fraction alpha[a0 + q].  A sphere + band is convex,
+ * so a grid line meets it in one segment (two if a periodic face cuts it). */
 typedef struct {
-    double alpha;
-    int32_t m;      /* G_IDX of the node in the component's field */
+    double r0[3];
+    int32_t m0;     /* G_IDX of the first node */
+    int32_t a0;     /* index of its α in the alpha array */
+    int16_t len;
     uint8_t c;      /* velocity component */
-    int8_t img[3];  /* periodic image: the node seen by this sphere is at
-                     * its stored position + img[d] L[d] */
-} ibm_node_t;
+    uint8_t shared; /* another sphere's band may reach a node of the run */
+} ibm_run_t;
 
 typedef struct {
     int n;
@@ -26,10 +32,24 @@ typedef struct {
 enum { IBM_FIMP = 0, IBM_TIMP = 3, IBM_MOM = 6, IBM_ANG = 9, IBM_NSUM = 12 };
 
 typedef struct {
-    /* node lists: sphere p owns nodes[start[p] .. start[p+1]) */
-    ibm_node_t *nodes;
-    long nnodes, cap;
+    /* runs: sphere p owns runs[start[p] .. start[p+1]) */
+    ibm_run_t *runs;
+    long nruns, cap_runs;
     long *start;
+    double *alpha;
+    long nalpha, cap_alpha, nshared;
+    int rdir;          /* run direction (2 in 3-D, 1 in 2-D), its stride and spacing */
+    long rstride;
+    double rstep;
+    /* neighbours of each sphere: the spheres (periodic images included)
+     * whose band may reach its nodes, nb[nb_start[p] .. nb_start[p+1]), each
+     * with the offset of that image's centre from sphere p's */
+    struct ibm_neighbour {
+        int o;
+        double d[3];
+    } *nb;
+    int *nb_start;
+    long nb_cap;
     /* dense scratch of each component: Σ_p α_p, then Σ_p α_p U_p and the
      * impulse of the forcing (zero outside the node lists between uses) */
     double *asum[3], *aux[3];
@@ -52,8 +72,8 @@ static inline ibm_priv_t *ibm_priv(const ibm_t *ibm) { return (ibm_priv_t *)ibm-
 
 /* alpha.c */
 void ibm_build_nodes(ibm_t *ibm);
-/* Position of the node of entry e relative to the centre of sphere p. */
-void ibm_node_offset(const ibm_t *ibm, const ibm_node_t *e, const ibm_sphere_t *s, double r[3]);
+/* Local x index of storage index m. */
+static inline int ibm_node_i(const grid_t *g, long m) { return (int)(m / g->sx) - 1; }
 /* Rigid-body velocity component c of sphere s at offset r. */
 static inline double ibm_rigid_velocity(const ibm_sphere_t *s, int c, const double r[3])
 {
