@@ -348,6 +348,8 @@ int main(int argc, char **argv)
 {
     test_mpi_init(&argc, &argv);
     modules_register_keys();
+    /* IBM_TESTS=pattern runs only the matching tests (scripts/validate.sh) */
+    if (getenv("IBM_TESTS")) cmocka_set_test_filter(getenv("IBM_TESTS"));
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_initial_acceleration),
         cmocka_unit_test(test_settling_sphere),
