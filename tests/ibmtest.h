@@ -81,4 +81,28 @@ static inline double it_schiller_naumann(double D, double rho_ratio, double g, d
     return 0.5 * (lo + hi);
 }
 
+/* Least-squares fit of y ≈ Σ_r x_r f_r(t) with three basis functions
+ * given at each sample as f[3*i + r]; returns the coefficients in x. */
+static inline void it_lsq3(int n, const double *f, const double *y, double x[3])
+{
+    double A[3][3] = {{0}}, b[3] = {0};
+    for (int i = 0; i < n; i++)
+        for (int r = 0; r < 3; r++) {
+            b[r] += f[3 * i + r] * y[i];
+            for (int c = 0; c < 3; c++) A[r][c] += f[3 * i + r] * f[3 * i + c];
+        }
+    /* Gaussian elimination (3 × 3, symmetric positive definite) */
+    for (int k = 0; k < 3; k++)
+        for (int r = k + 1; r < 3; r++) {
+            double m = A[r][k] / A[k][k];
+            for (int c = k; c < 3; c++) A[r][c] -= m * A[k][c];
+            b[r] -= m * b[k];
+        }
+    for (int r = 2; r >= 0; r--) {
+        x[r] = b[r];
+        for (int c = r + 1; c < 3; c++) x[r] -= A[r][c] * x[c];
+        x[r] /= A[r][r];
+    }
+}
+
 #endif

@@ -20,29 +20,14 @@
 /* Least-squares quadratic through (t, f); returns max |f − fit|. */
 static double quadratic_residual(int n, const double *t, const double *f)
 {
-    double A[3][3] = {{0}}, b[3] = {0}, t0 = t[0];
+    double basis[3 * 64], x[3], m = 0;
     for (int i = 0; i < n; i++) {
-        double s = t[i] - t0, p[3] = {1, s, s * s};
-        for (int r = 0; r < 3; r++) {
-            b[r] += p[r] * f[i];
-            for (int c = 0; c < 3; c++) A[r][c] += p[r] * p[c];
-        }
+        double s = t[i] - t[0];
+        basis[3 * i] = 1, basis[3 * i + 1] = s, basis[3 * i + 2] = s * s;
     }
-    for (int k = 0; k < 3; k++)
-        for (int r = k + 1; r < 3; r++) {
-            double m = A[r][k] / A[k][k];
-            for (int c = k; c < 3; c++) A[r][c] -= m * A[k][c];
-            b[r] -= m * b[k];
-        }
-    double x[3];
-    for (int r = 2; r >= 0; r--) {
-        x[r] = b[r];
-        for (int c = r + 1; c < 3; c++) x[r] -= A[r][c] * x[c];
-        x[r] /= A[r][r];
-    }
-    double m = 0;
+    it_lsq3(n, basis, f, x);
     for (int i = 0; i < n; i++) {
-        double s = t[i] - t0;
+        double s = t[i] - t[0];
         m = fmax(m, fabs(f[i] - (x[0] + x[1] * s + x[2] * s * s)));
     }
     return m;

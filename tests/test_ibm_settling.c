@@ -90,27 +90,16 @@ static double mean_velocity(const settle_t *s, double t0, double t1)
  * √t and the next order as the other terms. */
 static double initial_acceleration(const settle_t *s, double tmax)
 {
-    double A[3][3] = {{0}}, b[3] = {0};
-    for (int i = 0; i < s->n && s->t[i] <= tmax + 1e-12; i++) {
-        double t = s->t[i], f[3] = {1.0, sqrt(t), t}, y = s->v[i] / t;
-        for (int r = 0; r < 3; r++) {
-            b[r] += f[r] * y;
-            for (int c = 0; c < 3; c++) A[r][c] += f[r] * f[c];
-        }
+    int n = 0;
+    double *basis = calloc(3 * (size_t)s->n + 3, sizeof(double)), *y = calloc((size_t)s->n + 1, sizeof(double)), x[3];
+    for (int i = 0; i < s->n && s->t[i] <= tmax + 1e-12; i++, n++) {
+        double t = s->t[i];
+        basis[3 * n] = 1.0, basis[3 * n + 1] = sqrt(t), basis[3 * n + 2] = t;
+        y[n] = s->v[i] / t;
     }
-    /* Gaussian elimination (3 × 3, symmetric positive definite) */
-    for (int k = 0; k < 3; k++)
-        for (int r = k + 1; r < 3; r++) {
-            double m = A[r][k] / A[k][k];
-            for (int c = k; c < 3; c++) A[r][c] -= m * A[k][c];
-            b[r] -= m * b[k];
-        }
-    double x[3];
-    for (int r = 2; r >= 0; r--) {
-        x[r] = b[r];
-        for (int c = r + 1; c < 3; c++) x[r] -= A[r][c] * x[c];
-        x[r] /= A[r][r];
-    }
+    it_lsq3(n, basis, y, x);
+    free(basis);
+    free(y);
     return x[0];
 }
 

@@ -168,18 +168,15 @@ static void write_xmf(const ibm_part_t *ip)
                 "        <DataItem Dimensions=\"%d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/position</DataItem>\n"
                 "      </Geometry>\n",
                 i, ip->snap_time[i], n, n, file);
-        for (int a = 0; a < 4; a++)
+        for (int a = 0; a < 7; a++) {
+            int vector = a < 4;
+            const char *name = vector ? vec[a] : sca[a - 4];
             fprintf(f,
-                    "      <Attribute Name=\"%s\" AttributeType=\"Vector\" Center=\"Node\">\n"
-                    "        <DataItem Dimensions=\"%d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/%s</DataItem>\n"
+                    "      <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n"
+                    "        <DataItem Dimensions=\"%d%s\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/%s</DataItem>\n"
                     "      </Attribute>\n",
-                    vec[a], n, file, vec[a]);
-        for (int a = 0; a < 3; a++)
-            fprintf(f,
-                    "      <Attribute Name=\"%s\" AttributeType=\"Scalar\" Center=\"Node\">\n"
-                    "        <DataItem Dimensions=\"%d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/%s</DataItem>\n"
-                    "      </Attribute>\n",
-                    sca[a], n, file, sca[a]);
+                    name, vector ? "Vector" : "Scalar", n, vector ? " 3" : "", file, name);
+        }
         fprintf(f, "    </Grid>\n");
     }
     fprintf(f, "  </Grid>\n  </Domain>\n</Xdmf>\n");

@@ -494,7 +494,7 @@ ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f)
     char hist[IBM_KEYED_SPHERES][1024];
     int hist_of[IBM_KEYED_SPHERES], hist_key[IBM_KEYED_SPHERES], nh = 0;
     for (int k = 1; k <= IBM_KEYED_SPHERES; k++) {
-        char key[16];
+        char key[24];
         snprintf(key, sizeof key, "sphere%d", k);
         if (!cfg_has(cfg, "ibm", key)) continue;
         s = realloc(s, (size_t)(n + 1) * sizeof *s);
@@ -537,7 +537,7 @@ ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f)
     ibm_t *ibm = ibm_create(f, &prm, s, n);
     for (int h = 0; h < nh; h++) {
         int nrow;
-        char key[16];
+        char key[24];
         snprintf(key, sizeof key, "sphere%d", hist_key[h]);
         double *rows = read_history(cfg, key, hist[h], &nrow);
         ibm_sphere_t *sp = &ibm->s[hist_of[h]];
