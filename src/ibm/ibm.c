@@ -529,6 +529,24 @@ ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f)
         }
     }
     if (n == 0) cfg_fail(cfg, "ibm", "sphere1", "the [ibm] section defines no sphere (sphere1.. or spheres_file)");
+    /* along a periodic direction a sphere and its band must fit in the period */
+    double band = ibm_band_halfwidth();
+    for (int p = 0; p < n; p++)
+        for (int d = 0; d < g->dim; d++) {
+            double h = d == 0 ? g->gdxf[0] : d == 1 ? g->dy : g->dz;
+            if (g->periodic[d] && 2 * (s[p].radius + (band + 0.5) * h) + h > g->L[d]) {
+                char key[24];
+                int k = 0, seen = 0;
+                for (k = 1; k <= IBM_KEYED_SPHERES; k++) {
+                    snprintf(key, sizeof key, "sphere%d", k);
+                    if (cfg_has(cfg, "ibm", key) && seen++ == p) break;
+                }
+                cfg_fail(cfg, "ibm", k <= IBM_KEYED_SPHERES ? key : "spheres_file",
+                         "sphere %d (radius %g) and its band of %.2f cells do not fit in the periodic %c length %g: "
+                         "enlarge the domain",
+                         p + 1, s[p].radius, band, "xyz"[d], g->L[d]);
+            }
+        }
     for (int p = 0; p < n; p++)
         if (prm.force_model == IBM_FORCE_RIGID && s[p].kind == IBM_FREE &&
             fabs(s[p].density - f->prm.rho) < 1e-12 * f->prm.rho)
