@@ -49,6 +49,7 @@ typedef struct {
     double momentum[3];        /* Σ m v of the mobile particles */
     double com[3];             /* centre of mass of the mobile particles */
     long rebuilds;             /* neighbour-list rebuilds so far */
+    long contacts_started;     /* contacts (pairs and walls) started since the creation */
 } dem_diag_t;
 
 /* Case-file schema of [particles], [contact], [walls], [bed], [packing], [dem]. */

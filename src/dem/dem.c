@@ -204,7 +204,7 @@ void dem_compute_forces(dem_t *d)
     }
     double t2 = wtime();
     d->t_wall += t2 - t1;
-    if (d->nranks > 1) {
+    if (d->split) {
         MPI_Allreduce(MPI_IN_PLACE, d->f, 3 * d->n, MPI_DOUBLE, MPI_SUM, d->comm);
         MPI_Allreduce(MPI_IN_PLACE, d->t, 3 * d->n, MPI_DOUBLE, MPI_SUM, d->comm);
         double extra[3 * DEM_MAX_WALLS + 3];
@@ -328,6 +328,12 @@ static dem_status_t dem_setup(dem_t *d)
     dem_sync_velocities(d);
     dem_check_scene(d);
     if (d->dt <= 0) dem_set_dt(d);
+    if (!d->split_decided) {
+        /* replicated: every rank computes everything (no communication);
+         * split: the pairs are shared and the forces summed */
+        d->split = d->nranks > 1 && (d->parallel_mode == 2 || (d->parallel_mode == 0 && d->n >= 4000));
+        d->split_decided = 1;
+    }
     dem_status_t st = dem_neigh_build(d);
     if (st != DEM_OK) return st;
     memset(d->dv, 0, 3 * (size_t)d->n * sizeof(double));
@@ -516,6 +522,8 @@ void dem_diag(dem_t *d, dem_diag_t *o)
     o->n_contacts = d->n_contacts;
     o->n_wall_contacts = d->n_wall_contacts;
     o->max_overlap = d->max_overlap;
-    if (d->nranks > 1) MPI_Allreduce(MPI_IN_PLACE, &o->max_overlap, 1, MPI_DOUBLE, MPI_MAX, d->comm);
+    if (d->split) MPI_Allreduce(MPI_IN_PLACE, &o->max_overlap, 1, MPI_DOUBLE, MPI_MAX, d->comm);
     o->rebuilds = d->rebuilds;
+    o->contacts_started = d->n_starts;
+    if (d->split) MPI_Allreduce(MPI_IN_PLACE, &o->contacts_started, 1, MPI_LONG, MPI_SUM, d->comm);
 }

@@ -94,6 +94,9 @@ static const cfg_key_t dem_keys[] = {
     {"dem", "skin", CFG_DOUBLE, "0.1", 1e-4, 2, NULL, "Verlet skin as a fraction of the largest diameter"},
     {"dem", "sort_every", CFG_INT, "1", 0, 1000000, NULL,
      "reorder the particles by cell every this many list rebuilds (0: never)"},
+    {"dem", "parallel", CFG_ENUM, "auto", 1, 0, "auto|replicated|split",
+     "several ranks: every rank computes everything (replicated), or the pairs are shared and the forces summed "
+     "(split); auto: split from 4000 particles"},
     {"dem", "t_end", CFG_DOUBLE, NULL, 0, BIG, NULL, "end time of the run (s)"},
     {"dem", "max_overlap", CFG_DOUBLE, "0.01", 1e-9, 1, NULL,
      "stop (with a checkpoint) when an overlap exceeds this fraction of the smaller diameter"},
@@ -523,6 +526,7 @@ dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
     d->skin_rel = cfg_double(cfg, "dem", "skin");
     d->sort_every = cfg_int(cfg, "dem", "sort_every");
     d->max_overlap_allowed = cfg_double(cfg, "dem", "max_overlap");
+    d->parallel_mode = cfg_enum(cfg, "dem", "parallel");
     d->hist_update = 1;
     config_walls(d, cfg);
     dem_config_bed(d, cfg);

@@ -240,7 +240,7 @@ void dem_write_checkpoint(dem_t *d, const char *path)
 {
     dem_sync_velocities(d);
     /* histories live on their owner rank: share them first */
-    if (d->nranks > 1 && d->nb_start) {
+    if (d->split && d->nb_start) {
         /* a rebuild gathers them; do it without moving anything */
         const int sort = d->sort_every;
         d->sort_every = 0;

@@ -56,7 +56,7 @@ static void wall_reserve(dem_wall_t *W, int need)
 /* Rows [lo, hi) of rank q so that the pair counts are balanced. */
 static void partition_of(const dem_t *d, int q, int *lo, int *hi)
 {
-    if (d->nranks == 1) {
+    if (!d->split) {
         *lo = 0;
         *hi = d->n;
         return;
@@ -173,7 +173,7 @@ dem_status_t dem_neigh_build(dem_t *d)
 {
     const double t0 = wtime();
     const int n = d->n;
-    if (d->nranks > 1 && d->nb_start) gather_histories(d);
+    if (d->split && d->nb_start) gather_histories(d);
 
     /* 1. wrap periodic coordinates, check the domain */
     for (int i = 0; i < n; i++) {

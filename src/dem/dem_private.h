@@ -68,6 +68,9 @@ extern const char dem_contact_law_choices[];
 struct dem {
     MPI_Comm comm;
     int rank, nranks;
+    int parallel_mode;   /* 0 auto, 1 replicated, 2 split */
+    int split;           /* 1: the pairs are shared among the ranks, forces summed */
+    int split_decided;
 
     /* particles: structure of arrays (3-vectors stored as x,y,z) */
     int n, cap;
@@ -133,6 +136,7 @@ struct dem {
 
     /* diagnostics of the last step */
     long n_contacts, n_wall_contacts;
+    long n_starts;       /* contacts started on this rank since the creation (pairs and walls) */
     double max_overlap;
     char errmsg[512];
     /* snapshots written (for the XDMF index) */
