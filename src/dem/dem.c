@@ -183,6 +183,15 @@ void dem_check_scene(dem_t *d)
     }
 }
 
+/* Replicated: every rank computes everything (no communication); split: the
+ * pairs are shared among the ranks and the forces summed.  Decided once. */
+void dem_decide_split(dem_t *d)
+{
+    if (d->split_decided) return;
+    d->split = d->nranks > 1 && (d->parallel_mode == 2 || (d->parallel_mode == 0 && d->n >= 4000));
+    d->split_decided = 1;
+}
+
 /* ---- forces ---- */
 
 void dem_compute_forces(dem_t *d)
@@ -328,12 +337,7 @@ static dem_status_t dem_setup(dem_t *d)
     dem_sync_velocities(d);
     dem_check_scene(d);
     if (d->dt <= 0) dem_set_dt(d);
-    if (!d->split_decided) {
-        /* replicated: every rank computes everything (no communication);
-         * split: the pairs are shared and the forces summed */
-        d->split = d->nranks > 1 && (d->parallel_mode == 2 || (d->parallel_mode == 0 && d->n >= 4000));
-        d->split_decided = 1;
-    }
+    dem_decide_split(d);
     dem_status_t st = dem_neigh_build(d);
     if (st != DEM_OK) return st;
     memset(d->dv, 0, 3 * (size_t)d->n * sizeof(double));

@@ -162,6 +162,7 @@ void dem_grow(dem_t *d, int need);
 void dem_set_dt(dem_t *d);
 /* Checks that need the particles (periodic lengths); sets the skin and image shifts. */
 void dem_check_scene(dem_t *d);
+void dem_decide_split(dem_t *d);
 void dem_compute_forces(dem_t *d);
 /* Finish a pending half kick so that v, w are full-step values. */
 void dem_sync_velocities(dem_t *d);
