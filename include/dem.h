@@ -74,6 +74,8 @@ dem_status_t dem_step(dem_t *d);
 /* Advance to t_target with equal steps no longer than dem_dt() (sub-cycling
  * inside a fluid step).  External forces are held constant. */
 dem_status_t dem_advance(dem_t *d, double t_target);
+/* nsteps steps of size dem_dt(). */
+dem_status_t dem_run_steps(dem_t *d, long nsteps);
 const char *dem_error(const dem_t *d);
 
 double dem_dt(const dem_t *d);
@@ -100,6 +102,9 @@ const double *dem_contact_forces(const dem_t *d);
 
 /* Bytes allocated by the DEM per particle (particles, lists, cells, walls). */
 double dem_memory_per_particle(const dem_t *d);
+
+/* Time spent in the parts of a step (rank 0 prints). */
+void dem_print_timers(const dem_t *d);
 
 /* Walls */
 int dem_wall_count(const dem_t *d);

@@ -140,6 +140,7 @@ void dem_free(dem_t *d)
     void *arr[] = {d->x, d->v, d->w, d->f, d->t, d->dv, d->dw, d->fext, d->text,
                    d->r, d->invm, d->invI, d->rho, d->id, d->fixed};
     for (size_t a = 0; a < sizeof arr / sizeof arr[0]; a++) free(arr[a]);
+    free(d->kernel_block);
     free(d->snap_t);
     free(d->snap_n);
     free(d->snap_index);
@@ -197,6 +198,7 @@ void dem_decide_split(dem_t *d)
 void dem_compute_forces(dem_t *d)
 {
     double t0 = wtime();
+    if (!d->kernel_block) d->kernel_block = xcalloc(1, DEM_KERNEL_BLOCK_BYTES);
     memset(d->f, 0, 3 * (size_t)d->n * sizeof(double));
     memset(d->t, 0, 3 * (size_t)d->n * sizeof(double));
     d->n_contacts = d->n_wall_contacts = 0;
@@ -413,6 +415,17 @@ dem_status_t dem_advance(dem_t *d, double t_target)
     return st;
 }
 
+dem_status_t dem_run_steps(dem_t *d, long nsteps)
+{
+    dem_status_t st = DEM_OK;
+    if (!d->ready && (st = dem_setup(d)) != DEM_OK) return st;
+    for (long s = 0; s < nsteps && st == DEM_OK; s++) st = step_once(d);
+    double t0 = wtime();
+    dem_sync_velocities(d);
+    d->t_integ += wtime() - t0;
+    return st;
+}
+
 /* ---- accessors ---- */
 
 const char *dem_error(const dem_t *d) { return d->errmsg; }
@@ -460,6 +473,12 @@ double dem_memory_per_particle(const dem_t *d)
     bytes += (double)(d->ncell + 1) * sizeof(int) + 2.0 * (d->n + 1) * sizeof(int);
     for (int w = 0; w < d->nwall; w++) bytes += (double)d->wall[w].cap * (sizeof(int) + 1 + 3 * sizeof(double));
     return bytes / n;
+}
+
+void dem_print_timers(const dem_t *d)
+{
+    msg("dem timers: pairs %.3f s, walls %.3f s, lists %.3f s (%ld builds), integration %.3f s, communication %.3f s\n",
+        d->t_pair, d->t_wall, d->t_build, d->rebuilds, d->t_integ, d->t_comm);
 }
 
 /* ---- diagnostics ---- */

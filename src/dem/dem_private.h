@@ -14,6 +14,8 @@
 
 #define DEM_MAX_WALLS 16
 #define DEM_MAX_USER_WALLS 6
+/* bytes of the pair loop's work space: 128 contacts × (3 ints + 38 doubles) */
+#define DEM_KERNEL_BLOCK_BYTES (128 * (3 * sizeof(int) + 40 * sizeof(double)))
 
 typedef struct {
     char name[24];
@@ -131,6 +133,7 @@ struct dem {
     long nb_n, nb_cap;
     int nb_n_rows;       /* particles (rows) covered by the list */
     double shift[27][3];
+    void *kernel_block;  /* work space of the pair loop (dem_kernel.inc) */
     /* the rank's share: rows [row_lo, row_hi) of the list */
     int row_lo, row_hi;
 
