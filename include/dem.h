@@ -34,7 +34,8 @@ typedef enum {
     DEM_OK = 0,
     DEM_ERR_OVERLAP,    /* an overlap exceeded dem.max_overlap × the smaller diameter */
     DEM_ERR_LEFT_DOMAIN,/* a particle centre left the domain through a non-periodic face */
-    DEM_ERR_NAN         /* a non-finite position or velocity */
+    DEM_ERR_NAN,        /* a non-finite position or velocity */
+    DEM_ERR_TIMESTEP    /* dem.dt above t_c/20 for the contact time of the particles present */
 } dem_status_t;
 
 typedef struct {

@@ -149,19 +149,23 @@ void dem_free(dem_t *d)
 
 /* ---- time step ---- */
 
-void dem_set_dt(dem_t *d)
+dem_status_t dem_set_dt(dem_t *d)
 {
     d->tc = d->law->contact_time(d);
     if (d->dt_user > 0) {
-        if (d->dt_user > d->tc / 20.0 * (1 + 1e-12))
-            die("dem.dt = %g s is too large for the contact time t_c = %g s: it must not exceed t_c/20 = %g s "
-                "(set dem.dt = 0 to use t_c/steps_per_contact)",
-                d->dt_user, d->tc, d->tc / 20.0);
         d->dt = d->dt_user;
+        if (d->dt_user > d->tc / 20.0 * (1 + 1e-12)) {
+            snprintf(d->errmsg, sizeof d->errmsg,
+                     "dem.dt = %g s is too large for the contact time t_c = %g s of these particles: it must not "
+                     "exceed t_c/20 = %g s (set dem.dt = 0 to use t_c/steps_per_contact)",
+                     d->dt_user, d->tc, d->tc / 20.0);
+            return DEM_ERR_TIMESTEP;
+        }
     } else {
         if (!isfinite(d->tc)) die("dem: no mobile particle: cannot derive the time step from the contact time");
         d->dt = d->tc / d->n_c;
     }
+    return DEM_OK;
 }
 
 /* Checks that need the particles: periodic lengths, skin. */
@@ -338,7 +342,10 @@ static dem_status_t dem_setup(dem_t *d)
 {
     dem_sync_velocities(d);
     dem_check_scene(d);
-    if (d->dt <= 0) dem_set_dt(d);
+    if (d->dt <= 0) {
+        const dem_status_t st = dem_set_dt(d);
+        if (st != DEM_OK) return st;
+    }
     dem_decide_split(d);
     dem_status_t st = dem_neigh_build(d);
     if (st != DEM_OK) return st;

@@ -529,7 +529,17 @@ dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
     d->parallel_mode = cfg_enum(cfg, "dem", "parallel");
     d->hist_update = 1;
     config_walls(d, cfg);
+    const int src = cfg_enum(cfg, "particles", "source");
+    if (src == 2 && cfg_enum(cfg, "bed", "type") != 0)
+        cfg_fail(cfg, "bed", "type", "must be none when the particles come from a packing file (it holds the bed)");
     dem_config_bed(d, cfg);
     dem_config_particles(d, cfg);
+    /* a time step too large for the contact time: stop now when it is known */
+    if (d->dt_user > 0) {
+        const double tc = d->law->contact_time(d);
+        if (isfinite(tc) && d->dt_user > tc / 20.0 * (1 + 1e-12))
+            cfg_fail(cfg, "dem", "dt", "%g s is too large for the contact time t_c = %g s: it must not exceed t_c/20 = %g s",
+                     d->dt_user, tc, tc / 20.0);
+    }
     return d;
 }

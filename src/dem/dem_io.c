@@ -351,7 +351,7 @@ void dem_read_checkpoint(dem_t *d, const char *path)
     int restored = 0;
     dem_check_scene(d);
     dem_decide_split(d);
-    if (d->dt <= 0) dem_set_dt(d);
+    if (d->dt <= 0 && dem_set_dt(d) != DEM_OK) die("dem: %s", d->errmsg);
     dem_neigh_build(d);
     long *sorted = malloc(((size_t)n + 1) * sizeof(long));
     int *index_of = malloc(((size_t)n + 1) * sizeof(int));

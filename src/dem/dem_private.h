@@ -162,7 +162,7 @@ void dem_neigh_partition(dem_t *d);
 
 /* ---- internal helpers (dem.c) ---- */
 void dem_grow(dem_t *d, int need);
-void dem_set_dt(dem_t *d);
+dem_status_t dem_set_dt(dem_t *d);
 /* Checks that need the particles (periodic lengths); sets the skin and image shifts. */
 void dem_check_scene(dem_t *d);
 void dem_decide_split(dem_t *d);
