@@ -38,7 +38,7 @@
 #include "poisson.h"
 #include "util.h"
 
-#define MG_GATHER_CELLS 32768 /* levels at most this large live on rank 0 alone */
+#define MG_GATHER_CELLS 4096 /* levels at most this large (16³) live on rank 0 alone */
 #define MG_ANISOTROPY 1.5     /* halve a direction if its spacing ≤ 1.5 × the finest one */
 #define MG_COARSE_TOL 1e-8    /* coarsest-level CG: residual reduction */
 
