@@ -59,6 +59,8 @@ typedef struct {
     const double *b;
     double *bbuf;   /* storage of b on coarse levels */
     double *dgy, *dgz; /* y and z parts of the diagonal of L, BC folded (index j, k) */
+    double *rowbuf;    /* one row of the smoother */
+    double *zbuf;      /* prolongation: coarse rows interpolated along z */
     /* link to the next level */
     int link, coarsen[3];
     mg_row_t *rst[3]; /* restriction rows, indexed by the coarse (local) index */
@@ -129,42 +131,78 @@ static double sum_squares(const mg_level_t *L, const double *f)
      cz * (x[c + 1] - 2.0 * x[c] + x[c - 1]))
 #define STENCIL_2D(x, c) (cw * x[c - sx] + ce * x[c + sx] - cdl * x[c] + cy * (x[c + sy] - 2.0 * x[c] + x[c - sy]))
 
-/* One half-sweep of red-black Gauss–Seidel: every unknown of colour
- * (i_global + j + k) mod 2 = colour is set so that its row of (L − λI)x = b
+/* Red-black Gauss–Seidel on plane i (local) for one colour: every unknown of
+ * colour (i_global + j + k) mod 2 is set so that its row of (L − λI)x = b
  * holds.  Points of one colour do not touch each other, so the result does
- * not depend on the order or on the decomposition. */
-static void rb_half_sweep(mg_level_t *L, double lambda, int colour)
+ * not depend on the order or on the decomposition.  Each contiguous row (k
+ * in 3-D, j in 2-D) is updated for all points into a buffer — vectorisable,
+ * since only the other colour is read — and the points of this colour are
+ * copied back. */
+static void rb_plane(mg_level_t *L, double lambda, int i, int colour)
 {
     const grid_t *g = L->g;
     const poisson_t *op = L->op;
-    double *x = L->x;
+    double *x = L->x, *tmp = L->rowbuf;
     const double *b = L->b;
-    poisson_fill_ghosts(op, x);
-    int nux = local_nux(L), nu1 = level_nu(L, 1), nu2 = level_nu(L, 2);
-    long sx = g->sx, sy = g->sy;
-    double cy = op->cy, cz = op->cz;
-    for (int i = 0; i < nux; i++) {
-        int ig = i + g->ix0;
-        double cw = op->cw[ig], ce = op->ce[ig], cdl = op->cd[ig] + lambda;
-        for (int j = 0; j < nu1; j++) {
-            long c0 = G_IDX(g, i, j, 0);
-            double dj = cdl + L->dgy[j];
-            if (g->dim == 3) {
-                for (int k = (ig + j + colour) & 1; k < nu2; k += 2) {
-                    long c = c0 + k;
-                    x[c] += (STENCIL_3D(x, c) - b[c]) / (dj + L->dgz[k]);
-                }
-            } else if (((ig + j + colour) & 1) == 0) {
-                x[c0] += (STENCIL_2D(x, c0) - b[c0]) / dj;
-            }
-        }
+    int nu1 = level_nu(L, 1), nu2 = level_nu(L, 2), d3 = g->dim == 3;
+    /* the row direction (stride 1), and the second uniform direction (stride s2; none in 2-D) */
+    int n = d3 ? nu2 : nu1, nrows = d3 ? nu1 : 1, ig = i + g->ix0;
+    long sx = g->sx, s2 = d3 ? g->sy : 0;
+    double cin = d3 ? op->cz : op->cy, c2 = d3 ? op->cy : 0.0;
+    const double *dgin = d3 ? L->dgz : L->dgy;
+    double cw = op->cw[ig], ce = op->ce[ig], cdl = op->cd[ig] + lambda;
+    for (int r = 0; r < nrows; r++) {
+        double *xr = x + G_IDX(g, i, r, 0);
+        const double *br = b + G_IDX(g, i, r, 0);
+        double dout = cdl + (d3 ? L->dgy[r] : 0.0); /* diagonal from x (and y in 3-D) */
+        double inv = 1.0 / (dout + 2.0 * cin);      /* interior of the row */
+#define RB_UPDATE(k, invd)                                                                                     \
+    (xr[k] + (cw * xr[(k) - sx] + ce * xr[(k) + sx] - cdl * xr[k] + c2 * (xr[(k) + s2] - 2.0 * xr[k] + xr[(k) - s2]) + \
+              cin * (xr[(k) + 1] - 2.0 * xr[k] + xr[(k) - 1]) - br[k]) *                                                \
+                 (invd))
+        for (int k = 0; k < n; k++) tmp[k] = RB_UPDATE(k, inv);
+        tmp[0] = RB_UPDATE(0, 1.0 / (dout + dgin[0])); /* ends of the row: BC folded in the diagonal */
+        tmp[n - 1] = RB_UPDATE(n - 1, 1.0 / (dout + dgin[n - 1]));
+#undef RB_UPDATE
+        for (int k = (ig + r + colour) & 1; k < n; k += 2) xr[k] = tmp[k];
     }
 }
 
+/* Periodic y/z ghosts of plane i (as grid_halo_yz: z first, then whole y rows). */
+static void periodic_ghosts_plane(const grid_t *g, double *f, int i)
+{
+    int ny = g->n[1], nz = g->n[2];
+    if (g->dim == 3 && g->periodic[2])
+        for (int j = 0; j < ny; j++) {
+            f[G_IDX(g, i, j, -1)] = f[G_IDX(g, i, j, nz - 1)];
+            f[G_IDX(g, i, j, nz)] = f[G_IDX(g, i, j, 0)];
+        }
+    if (g->periodic[1]) {
+        memcpy(f + G_IDX(g, i, -1, -g->gz), f + G_IDX(g, i, ny - 1, -g->gz), (size_t)g->sy * sizeof(double));
+        memcpy(f + G_IDX(g, i, ny, -g->gz), f + G_IDX(g, i, 0, -g->gz), (size_t)g->sy * sizeof(double));
+    }
+}
+
+/* One red-black sweep in a single pass over memory: red on plane i, then
+ * black on plane i−1, whose red neighbours are all new by then.  The ghosts
+ * filled at the start stay valid for the black points (a Neumann or
+ * Dirichlet ghost mirrors the point itself, not yet updated) except periodic
+ * images, refreshed plane by plane, and the x ghost planes, exchanged before
+ * the black points of the first and last planes.  Same arithmetic, hence the
+ * same bits, as two half-sweeps with a full ghost fill in between. */
 static void rb_sweep(mg_level_t *L, double lambda)
 {
-    rb_half_sweep(L, lambda, 0);
-    rb_half_sweep(L, lambda, 1);
+    const grid_t *g = L->g;
+    poisson_fill_ghosts(L->op, L->x);
+    int nux = local_nux(L);
+    for (int i = 0; i < nux; i++) {
+        rb_plane(L, lambda, i, 0);
+        periodic_ghosts_plane(g, L->x, i);
+        if (i >= 2) rb_plane(L, lambda, i - 1, 1);
+    }
+    grid_halo_x(g, L->x);
+    if (nux >= 1) rb_plane(L, lambda, 0, 1);
+    if (nux >= 2) rb_plane(L, lambda, nux - 1, 1);
 }
 
 /* ---------------------------------------------------- x-line relaxation */
@@ -455,13 +493,28 @@ static void restrict_residual(mg_level_t *F, mg_level_t *C)
     }
 }
 
-/* x_fine += P e_coarse. */
+/* x_fine += P e_coarse, as a tensor product: when z is coarsened, every
+ * coarse row is first interpolated along z into F->zbuf (coarse x, y; fine
+ * z), so the x–y part is contiguous multiply-adds. */
 static void prolong_add(mg_level_t *F, mg_level_t *C)
 {
     const grid_t *gf = F->g, *gc = C->g;
     double *e = C->x, *x = F->x;
     grid_halo(gc, e); /* rows refer to the neighbour slab or the periodic image in x */
     int nux = local_nux(F), nu1 = level_nu(F, 1), nu2 = level_nu(F, 2);
+    int zc = F->coarsen[2], nyc = gc->n[1];
+    if (zc)
+        for (int I = -1; I <= gc->nxl; I++)
+            for (int J = 0; J < nyc; J++) {
+                const double *in = e + G_IDX(gc, I, J, 0);
+                double *zr = F->zbuf + ((long)(I + 1) * nyc + J) * nu2;
+                for (int k = 0; k < nu2; k++) {
+                    const mg_row_t *pz = &F->prl[2][k];
+                    double s = 0.0;
+                    for (int c = 0; c < pz->n; c++) s += pz->w[c] * in[pz->idx[c]];
+                    zr[k] = s;
+                }
+            }
     for (int i = 0; i < nux; i++) {
         const mg_row_t *px = &F->prl[0][i];
         for (int j = 0; j < nu1; j++) {
@@ -470,12 +523,12 @@ static void prolong_add(mg_level_t *F, mg_level_t *C)
             for (int a = 0; a < px->n; a++)
                 for (int bb = 0; bb < py->n; bb++) {
                     double wxy = px->w[a] * py->w[bb];
-                    const double *in = e + G_IDX(gc, px->idx[a], py->idx[bb], 0);
-                    for (int k = 0; k < nu2; k++) {
-                        const mg_row_t *pz = &F->prl[2][k];
-                        double s = 0.0;
-                        for (int c = 0; c < pz->n; c++) s += pz->w[c] * in[pz->idx[c]];
-                        out[k] += wxy * s;
+                    if (zc) {
+                        const double *zr = F->zbuf + ((long)(px->idx[a] + 1) * nyc + py->idx[bb]) * nu2;
+                        for (int k = 0; k < nu2; k++) out[k] += wxy * zr[k];
+                    } else {
+                        const double *in = e + G_IDX(gc, px->idx[a], py->idx[bb], 0);
+                        for (int k = 0; k < nu2; k++) out[k] += wxy * in[k];
                     }
                 }
         }
@@ -775,6 +828,7 @@ static void level_alloc(mg_level_t *L, int coarsest)
     L->r = field_alloc(g);
     L->dgy = uniform_diag(L->op, 1, L->op->cy);
     L->dgz = uniform_diag(L->op, 2, L->op->cz);
+    L->rowbuf = xcalloc((size_t)(g->n[1] > g->n[2] ? g->n[1] : g->n[2]), sizeof(double));
     if (L->own) {
         L->x = field_alloc(g);
         L->bbuf = field_alloc(g);
@@ -882,6 +936,7 @@ static void *mg_create(poisson_t *p)
                 if (fabs(C->g->gxf[I] - F->g->gxf[2 * I + 1]) > 1e-12 * F->g->L[0])
                     die("multigrid: coarse x face %d is not fine face %d", I, 2 * I + 1);
         for (int d = 0; d < 3; d++) build_transfer(F, C, d, line);
+        if (F->coarsen[2]) F->zbuf = xcalloc((size_t)(C->g->nxl + 2) * C->g->n[1] * F->g->n[2], sizeof(double));
     }
     return m;
 }
@@ -899,6 +954,8 @@ static void mg_destroy(void *impl)
         free(L->r);
         free(L->dgy);
         free(L->dgz);
+        free(L->rowbuf);
+        free(L->zbuf);
         free(L->cg_z);
         free(L->cg_d);
         free(L->cg_q);
