@@ -77,9 +77,9 @@ void poisson_register_keys(void);
 void poisson_opts_from_config(cfg_t *cfg, poisson_opts_t *o);
 
 poisson_t *poisson_create(const grid_t *g, var_loc_t loc, const poisson_opts_t *opt);
-/* The operator description only (ebc, nu, cw/ce/cd, cy, cz), without a
- * solver back-end: multigrid rediscretises L on its coarse grids with it. */
-poisson_t *poisson_create_operator(const grid_t *g, var_loc_t loc, const poisson_opts_t *opt);
+/* The operator alone, without a solver back-end: poisson_apply and
+ * poisson_fill_ghosts work, poisson_solve does not (explicit viscous term). */
+poisson_t *poisson_create_operator(const grid_t *g, var_loc_t loc);
 void poisson_free(poisson_t *p);
 
 /* Solve (L − λI) x = b.  b and x are fields of the grid (x may equal b);

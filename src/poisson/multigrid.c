@@ -908,7 +908,7 @@ static void *mg_create(poisson_t *p)
             } else if (!serial || g0->rank == 0) {
                 L->g = grid_create(g0->geom, dims[s], g0->L, g0->x0, &g0->bc, g0->stretch, g0->stretch_beta,
                                    serial ? self : g0->comm);
-                L->op = poisson_create_operator(L->g, p->loc, &p->opt);
+                L->op = poisson_create_operator(L->g, p->loc);
                 L->own = 1;
             }
             if (L->g) level_alloc(L, L->link == LINK_NONE);

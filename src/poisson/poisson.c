@@ -40,19 +40,11 @@ static ebc_t face_ebc(const grid_t *g, var_loc_t loc, int d, int s)
     return EBC_NEUMANN;                           /* free slip, or a tangential component on the axis */
 }
 
-poisson_t *poisson_create_operator(const grid_t *g, var_loc_t loc, const poisson_opts_t *opt)
+poisson_t *poisson_create_operator(const grid_t *g, var_loc_t loc)
 {
     poisson_t *p = xcalloc(1, sizeof *p);
     p->g = g;
     p->loc = loc;
-    if (opt)
-        p->opt = *opt;
-    else {
-        p->opt.method = POISSON_FFT;
-        p->opt.mg_tol = 1e-10;
-        p->opt.mg_max_cycles = 100;
-        p->opt.mg_pre = p->opt.mg_post = 2;
-    }
     p->singular = 1;
     for (int d = 0; d < 3; d++)
         for (int s = 0; s < 2; s++) {
@@ -112,7 +104,15 @@ poisson_t *poisson_create_operator(const grid_t *g, var_loc_t loc, const poisson
 
 poisson_t *poisson_create(const grid_t *g, var_loc_t loc, const poisson_opts_t *opt)
 {
-    poisson_t *p = poisson_create_operator(g, loc, opt);
+    poisson_t *p = poisson_create_operator(g, loc);
+    if (opt)
+        p->opt = *opt;
+    else {
+        p->opt.method = POISSON_FFT;
+        p->opt.mg_tol = 1e-10;
+        p->opt.mg_max_cycles = 100;
+        p->opt.mg_pre = p->opt.mg_post = 2;
+    }
     p->backend = p->opt.method == POISSON_FFT ? &poisson_backend_fft : &poisson_backend_mg;
     p->impl = p->backend->create(p);
     return p;
@@ -250,6 +250,7 @@ void poisson_add_constant(const poisson_t *p, double *f, double c)
 
 int poisson_solve(poisson_t *p, double lambda, const double *b, double *x)
 {
+    if (!p->backend) die("poisson_solve: operator created without a solver (poisson_create_operator)");
     const double *rhs = b;
     double *tmp = NULL;
     int sing = p->singular && lambda == 0.0;
