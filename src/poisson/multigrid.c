@@ -651,6 +651,41 @@ static void coarse_solve(mg_level_t *L, double lambda)
 
 /* --------------------------------------------------------------- V-cycle */
 
+static void vcycle(mg_t *m, int l, double lambda, const poisson_opts_t *o);
+
+/* The part of a V-cycle after the residual L->r of the current x is known:
+ * coarse-grid correction and post-smoothing. */
+static void correct(mg_t *m, int l, double lambda, const poisson_opts_t *o)
+{
+    mg_level_t *L = &m->lev[l], *C = &m->lev[l + 1];
+    if (L->link == LINK_GATHER) {
+        /* the same grid on rank 0 solves for the correction */
+        gather_level(L, C, L->r, C->bbuf);
+        if (C->g) {
+            field_zero(C->g, C->x);
+            vcycle(m, l + 1, lambda, o);
+        }
+        scatter_add_level(L, C, C->x, L->x);
+        return;
+    }
+    restrict_residual(L, C);
+    /* The restriction keeps Σ w r = 0; remove the round-off left over. */
+    if (C->op->singular && lambda == 0.0) poisson_add_constant(C->op, C->bbuf, -poisson_weighted_mean(C->op, C->bbuf));
+    field_zero(C->g, C->x);
+    vcycle(m, l + 1, lambda, o);
+    prolong_add(L, C);
+    for (int s = 0; s < o->mg_post; s++) smooth(L, lambda);
+}
+
+/* Pre-smoothing (none before a gather: the copy on rank 0 smooths), then the
+ * residual; returns its global Σ r². */
+static double presmooth_residual(mg_level_t *L, double lambda, const poisson_opts_t *o)
+{
+    if (L->link != LINK_GATHER)
+        for (int s = 0; s < o->mg_pre; s++) smooth(L, lambda);
+    return residual(L, lambda, L->x, L->r);
+}
+
 static void vcycle(mg_t *m, int l, double lambda, const poisson_opts_t *o)
 {
     mg_level_t *L = &m->lev[l];
@@ -659,31 +694,8 @@ static void vcycle(mg_t *m, int l, double lambda, const poisson_opts_t *o)
         coarse_solve(L, lambda);
         return;
     }
-    mg_level_t *C = &m->lev[l + 1];
-    if (L->link == LINK_GATHER) {
-        /* Same grid on rank 0: coarse levels enter with x = 0, so gathering b
-         * is exact; the fine level gathers its residual (correction form). */
-        if (l == 0) {
-            residual(L, lambda, L->x, L->r);
-            gather_level(L, C, L->r, C->bbuf);
-        } else
-            gather_level(L, C, L->b, C->bbuf);
-        if (C->g) {
-            field_zero(C->g, C->x);
-            vcycle(m, l + 1, lambda, o);
-        }
-        scatter_add_level(L, C, C->x, L->x);
-        return;
-    }
-    for (int s = 0; s < o->mg_pre; s++) smooth(L, lambda);
-    residual(L, lambda, L->x, L->r);
-    restrict_residual(L, C);
-    /* The restriction keeps Σ w r = 0; remove the round-off left over. */
-    if (C->op->singular && lambda == 0.0) poisson_add_constant(C->op, C->bbuf, -poisson_weighted_mean(C->op, C->bbuf));
-    field_zero(C->g, C->x);
-    vcycle(m, l + 1, lambda, o);
-    prolong_add(L, C);
-    for (int s = 0; s < o->mg_post; s++) smooth(L, lambda);
+    presmooth_residual(L, lambda, o);
+    correct(m, l, lambda, o);
 }
 
 /* ------------------------------------------------------------- set-up */
@@ -994,19 +1006,26 @@ static int mg_solve(poisson_t *p, void *impl, double lambda, const double *b, do
     for (int i = 0; i < nux; i++)
         for (int j = 0; j < p->nu[1]; j++)
             for (int k = 0; k < p->nu[2]; k++) x[G_IDX(g, i, j, k)] = 0.0;
-    double bn = sqrt(sum_squares(L0, b)), rn = bn;
+    /* Convergence is tested on the residual computed after pre-smoothing
+     * (the one the cycle restricts), so the fine level needs one residual
+     * per cycle; the solve stops there, and last_residual is exactly the
+     * residual of the returned x. */
+    double bn = sqrt(sum_squares(L0, b)), rn = 0.0;
     int it = 0, rc = 0;
-    if (bn > 0.0) {
-        while (rn > p->opt.mg_tol * bn) {
+    if (bn > 0.0)
+        for (;;) {
+            rn = sqrt(L0->link == LINK_NONE ? residual(L0, lambda, x, L0->r) : presmooth_residual(L0, lambda, &p->opt));
+            if (rn <= p->opt.mg_tol * bn) break;
             if (it == p->opt.mg_max_cycles || !isfinite(rn)) {
                 rc = -1;
                 break;
             }
-            vcycle(m, 0, lambda, &p->opt);
+            if (L0->link == LINK_NONE)
+                coarse_solve(L0, lambda);
+            else
+                correct(m, 0, lambda, &p->opt);
             it++;
-            rn = sqrt(residual(L0, lambda, x, L0->r));
         }
-    }
     poisson_fill_ghosts(p, x);
     p->last_residual = bn > 0.0 ? rn / bn : 0.0;
     p->last_iterations = it;
