@@ -131,7 +131,11 @@ static void compute_results(void)
  * error in the coarsest solve, 0.23–0.31 for a restriction not matched to the
  * smoother, 0.27 for point smoothing on the stretched axisymmetric grid (all
  * seen in development) — and a smoother alone would give 1 − O(h²).  Grid
- * independence: twice the resolution costs at most two more cycles. */
+ * independence: for the Poisson cases, twice the resolution costs at most two
+ * more cycles.  (A Helmholtz problem gets harder as h shrinks, since λh² sets
+ * its diagonal dominance: λ = 1e4 takes 2–3 cycles at h = 1/32, 5 at 1/64.)
+ * The factor is (‖r‖/‖b‖)^(1/cycles), the residual being the one after the
+ * pre-smoothing that follows the last cycle (where the solver tests it). */
 static void test_mg_cycles_and_factor(void **state)
 {
     compute_results();
@@ -148,7 +152,8 @@ static void test_mg_cycles_and_factor(void **state)
             assert_true(r->res <= 1.01 * mg_opts.mg_tol);
             assert_true(r->factor < 0.2);
         }
-    for (size_t i = 0; i < NCASES; i++) assert_true(results[i][1].cycles <= results[i][0].cycles + 2);
+    for (size_t i = 0; i < NCASES; i++)
+        if (cases[i].lambda == 0.0) assert_true(results[i][1].cycles <= results[i][0].cycles + 2);
 }
 
 /* (2) The multigrid solution is the solution of the discrete operator, so it
