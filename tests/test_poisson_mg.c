@@ -304,11 +304,14 @@ static void test_mg_interface(void **state)
 
 /* (4) Multigrid and the direct FFT solver (src/poisson/fft.c) solve the same
  * discrete problem: their solutions agree to the multigrid tolerance.  The
- * FFT residual is at round-off (≤ 1e-13), so x_mg − x_fft = A⁻¹ r_mg; the
- * residual the V-cycles leave is smooth, and on smooth modes A⁻¹ scales
- * like the solution itself, so the relative difference is of the order of the
- * relative residual: measured ≤ 4.9e-11 for mg_tol = 1e-10 on 1 and 2 ranks.
- * Asserted: max difference ≤ mg_tol × max|x|. */
+ * FFT residual is at round-off (≤ 1e-13), so x_mg − x_fft = A⁻¹ r_mg with
+ * ‖r_mg‖₂ ≤ mg_tol ‖b‖₂.  For smooth residuals (Poisson) A⁻¹ scales the
+ * residual like the solution, for a diagonally dominant Helmholtz problem
+ * the error is r/λ pointwise: either way the relative difference is of the
+ * order of the relative residual, up to the ratio of max to L2 norms of the
+ * (concentrated) residual and the (spread) right-hand side.  Measured: up to
+ * 8.7e-11 for mg_tol = 1e-10 (λ = 1e4 case, 1 rank), typically 1e-11;
+ * asserted: max difference ≤ 10 mg_tol × max|x|. */
 static void test_mg_agrees_with_fft(void **state)
 {
     for (size_t i = 0; i < NCASES; i++) {
@@ -333,7 +336,7 @@ static void test_mg_agrees_with_fft(void **state)
         d = grid_max(g, d) / grid_max(g, mx);
         msg("  %-30s max|x_mg - x_fft| / max|x_fft| = %.1e  (fft residual %.1e)\n", c->name, d,
             poisson_residual(pf, c->lambda, b, xf));
-        assert_true(d <= mg_opts.mg_tol);
+        assert_true(d <= 10.0 * mg_opts.mg_tol);
         poisson_free(pm);
         poisson_free(pf);
         free(u);
