@@ -18,8 +18,10 @@
  *
  * Prints per problem: V-cycles, time per solve (best of `reps`), time per
  * V-cycle, mean convergence factor, the FFT solve of the same problem in the
- * same run and the ratio, and the peak resident set per cell (all ranks,
- * measured before the FFT solver is created).
+ * same run and the ratio, and the peak resident set per cell (summed over the
+ * ranks, read before the FFT solver of that problem is created; the peak is
+ * the process's high-water mark, so for a clean figure run one problem per
+ * process — bench/run.sh should call the three problems separately).
  *
  * usage: bench_mg [N=128] [reps=3] [walls|periodic|channel|all]
  */
