@@ -8,26 +8,28 @@
  * other fine face (checked) and its operator is L REDISCRETISED on that
  * grid by poisson_create_operator() — the same definition as the fine one,
  * stretched and axisymmetric metric included.  A direction is halved while
- * its cell count is even and ≥ 4 and its spacing is within MG_ANISOTROPY of
- * the finest spacing (semi-coarsening keeps the coarse grids isotropic,
- * which point smoothing needs).  The sequence of grids does not depend on the
- * rank count.  Levels are distributed like the fine grid (slabs in x) until
- * a level is small (≤ MG_GATHER_CELLS) or its nx does not divide among the
- * ranks; then it is gathered onto rank 0 and the rest of the hierarchy runs
- * there.
+ * its cell count is even and ≥ 4 and, with the point smoother, its spacing
+ * is within MG_ANISOTROPY of the smallest (semi-coarsening keeps the coarse
+ * grids isotropic); with the x-line smoother (stretched x) y and z are
+ * halved first and x only once they are exhausted.  The sequence of grids
+ * does not depend on the rank count.  Levels are distributed like the fine
+ * grid (slabs in x) until a level is small (≤ MG_GATHER_CELLS) or its
+ * successor's nx does not divide among the ranks; that level is gathered
+ * onto rank 0 and the rest of the hierarchy runs there.
  *
- * Transfers (per direction, tensor products).  Cell-centred direction:
- * restriction = volume-weighted average of the two children; prolongation =
- * linear interpolation between coarse centres (boundary ghosts from the BC).
- * Face-centred direction (the normal component): coarse face I = fine face
- * 2I+1; prolongation = linear interpolation; restriction = its weighted
- * adjoint (¼ ½ ¼ on a uniform grid).  Both restrictions preserve the
- * weighted sum Σ w r, so a compatible residual stays compatible.
+ * Transfers (per direction, tensor products).  Prolongation: linear
+ * interpolation, boundary conditions folded into its rows (build_transfer).
+ * Restriction: its adjoint in the volume-weighted inner product, except for
+ * cell-centred directions under the point smoother, which use the
+ * volume-weighted mean of the two children.  Both keep Σ w r, so a
+ * compatible residual stays compatible.
  *
- * Smoother: red-black Gauss–Seidel, colour (i_global + j + k) mod 2, so the
- * iterates do not depend on the decomposition.  Coarsest level: conjugate
- * gradients (Jacobi-preconditioned, in the inner product weighted by the
- * cell volumes, for which L is symmetric).
+ * Smoothers: red-black Gauss–Seidel, colour (i_global + j + k) mod 2, in one
+ * pass over memory per sweep (uniform x); zebra x-line Gauss–Seidel with the
+ * lines solved exactly across the slabs (stretched x).  Neither depends on
+ * the decomposition beyond round-off.  Coarsest level: conjugate gradients
+ * (Jacobi-preconditioned, in the inner product weighted by the cell volumes,
+ * for which L is symmetric).
  *
  * Start: x = 0 (poisson_solve passes x as output and x may alias b).
  */
@@ -39,12 +41,12 @@
 #include "util.h"
 
 #define MG_GATHER_CELLS 4096 /* levels at most this large (16³) live on rank 0 alone */
-#define MG_ANISOTROPY 1.5     /* halve a direction if its spacing ≤ 1.5 × the finest one */
+#define MG_ANISOTROPY 1.5     /* halve a direction if its spacing ≤ 1.5 × the smallest one */
 #define MG_COARSE_TOL 1e-8    /* coarsest-level CG: residual reduction */
 
 enum { LINK_NONE = 0, LINK_COARSEN, LINK_GATHER };
 
-/* One row of a 1-D transfer operator: up to 3 (index, weight) pairs. */
+/* One row of a 1-D transfer operator: up to 4 (index, weight) pairs. */
 typedef struct {
     int n;
     int idx[4];
