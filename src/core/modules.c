@@ -2,12 +2,16 @@
 #include "modules.h"
 
 #include "dem.h"
+#include "fluid.h"
 #include "grid.h"
 #include "poisson.h"
+#include "sim.h"
 
 void modules_register_keys(void)
 {
     grid_register_keys();
     poisson_register_keys();
+    fluid_register_keys();
+    sim_register_keys();
     dem_register_keys();
 }
