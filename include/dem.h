@@ -22,6 +22,7 @@
 #ifndef IBMDEM_DEM_H
 #define IBMDEM_DEM_H
 
+#include <hdf5.h>
 #include <mpi.h>
 
 #include "config.h"
@@ -114,8 +115,10 @@ void dem_wall_force(const dem_t *d, int w, double f[3]);
 int dem_wall_active(const dem_t *d, int w);
 const char *dem_wall_name(const dem_t *d, int w);
 
-/* Diagnostics (collective). */
+/* Diagnostics (collective).  dem_diag_light skips the elastic energy (a pass
+ * over the contacts). */
 void dem_diag(dem_t *d, dem_diag_t *out);
+void dem_diag_light(dem_t *d, dem_diag_t *out);
 
 /* Packing preparation as configured in [packing]: settle under gravity until
  * the kinetic energy per particle drops below the rest criterion (dense:
@@ -132,12 +135,25 @@ void dem_write_snapshot(dem_t *d, const char *dir, int index);
  * file is a checkpoint.  dem_read_checkpoint replaces the particles. */
 void dem_write_checkpoint(dem_t *d, const char *path);
 void dem_read_checkpoint(dem_t *d, const char *path);
+/* The same into / from an open HDF5 file or group (a part of a run checkpoint). */
+void dem_checkpoint_write_loc(dem_t *d, hid_t loc);
+void dem_checkpoint_read_loc(dem_t *d, hid_t loc, const char *path);
+/* After a restart: list the snapshots 0..first-1 already in dir in the XDMF index. */
+void dem_snapshots_resume(dem_t *d, const char *dir, int first);
+/* Number of snapshots written (or listed) so far. */
+int dem_snapshot_count(const dem_t *d);
 /* LAMMPS/LIGGGHTS data file (atom_style sphere: id type diameter density x y z). */
 void dem_write_lammps_data(dem_t *d, const char *path);
 
-/* Run a DEM-only case: preparation (if [packing] prepare), then the run to
- * [dem] t_end with snapshots, time series and checks; writes its outputs in
- * outdir.  Returns 0 on success, non-zero after a diagnostic stopped the run
+/* Rate of change of the grains for time.steady_tol: rms velocity / mean
+ * diameter of the mobile particles (1/s), INFINITY before time `after`. */
+double dem_rest_rate(dem_t *d, double after);
+
+/* Run a DEM-only case without the run driver (ibmdem run does the same
+ * through src/core/sim_dem.c): preparation (if [packing] prepare), then the
+ * run to time.t_end (or until the grains' rate of change dem_rest_rate falls
+ * below time.steady_tol) with snapshots every output.fields_every, the time
+ * series dem_series.csv and the checks; writes its outputs in outdir.  Returns 0 on success, non-zero after a diagnostic stopped the run
  * (a checkpoint was written). */
 int dem_run_case(cfg_t *cfg, const char *outdir);
 

@@ -36,7 +36,7 @@ static const char *bed_ini(const char *law, const char *variant, char *buf, size
              "[contact]\nlaw = %s\nrestitution = 0.5\ncontact_time = 2e-4\nfriction = 0.5\n"
              "youngs_modulus = 2e7\npoisson_ratio = 0.3\nreference_velocity = 0.5\n"
              "[packing]\nprepare = true\nvariant = %s\nrest_energy = 1e-6\nmax_time = 2\noutput = bed_%s_%s.h5\n"
-             "[dem]\ngravity = 0 0 -9.81\nt_end = 0.01\nsteps_per_contact = 20\nmax_overlap = 0.1\n",
+             "[dem]\ngravity = 0 0 -9.81\nsteps_per_contact = 20\nmax_overlap = 0.1\n",
              law, variant, law, variant);
     return buf;
 }

@@ -140,7 +140,7 @@ static void test_run_checkpoint(void **state)
     char text[2048];
     snprintf(text, sizeof text,
              "%s[particles]\nsource = insert\ncount = 20\nradius = 1e-3\nvelocity = 0 0 -3\n"
-             "[contact]\nrestitution = 0.5\ncontact_time = 1e-3\nfriction = 0.5\n[dem]\nt_end = 0.05\n",
+             "[contact]\nrestitution = 0.5\ncontact_time = 1e-3\nfriction = 0.5\n[time]\nt_end = 0.05\n",
              BOX);
     cfg_t *cfg = cfg_load_string("run.ini", text, 0, NULL);
     assert_non_null(cfg);

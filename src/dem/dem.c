@@ -493,7 +493,8 @@ void dem_print_timers(const dem_t *d)
 double dem_elastic_energy(const dem_t *d)
 {
     double e = 0.0;
-    for (int i = 0; i < d->nb_n_rows && i < d->n; i++)
+    const int lo = d->split ? d->row_lo : 0, hi = d->split ? d->row_hi : d->n;
+    for (int i = lo; i < d->nb_n_rows && i < hi; i++)
         for (int k = d->nb_start[i]; k < d->nb_start[i + 1]; k++) {
             const int j = d->nb_j[k];
             const double *s = d->shift[d->nb_img[k]];
@@ -513,6 +514,7 @@ double dem_elastic_energy(const dem_t *d)
         if (!W->active) continue;
         for (int e2 = 0; e2 < W->nlist; e2++) {
             const int i = W->idx[e2];
+            if (i < lo || i >= hi) continue;
             double dist = 0;
             for (int a = 0; a < 3; a++) dist += (d->x[3 * i + a] - W->p[a]) * W->n[a];
             const double delta = d->r[i] - dist;
@@ -524,7 +526,16 @@ double dem_elastic_energy(const dem_t *d)
     return e;
 }
 
+int dem_snapshot_count(const dem_t *d) { return d->nsnap ? d->snap_index[d->nsnap - 1] + 1 : 0; }
+
 void dem_diag(dem_t *d, dem_diag_t *o)
+{
+    dem_diag_light(d, o);
+    o->e_elastic = d->ready ? dem_elastic_energy(d) : 0.0;
+    if (d->split) MPI_Allreduce(MPI_IN_PLACE, &o->e_elastic, 1, MPI_DOUBLE, MPI_SUM, d->comm);
+}
+
+void dem_diag_light(dem_t *d, dem_diag_t *o)
 {
     dem_sync_velocities(d);
     memset(o, 0, sizeof *o);
@@ -548,7 +559,6 @@ void dem_diag(dem_t *d, dem_diag_t *o)
         o->ke_rot += 0.5 * I * w2;
     }
     for (int a = 0; a < 3; a++) o->com[a] = m_tot > 0 ? o->com[a] / m_tot : 0.0;
-    o->e_elastic = d->ready ? dem_elastic_energy(d) : 0.0;
     o->n_contacts = d->n_contacts;
     o->n_wall_contacts = d->n_wall_contacts;
     o->max_overlap = d->max_overlap;

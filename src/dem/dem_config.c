@@ -97,16 +97,14 @@ static const cfg_key_t dem_keys[] = {
     {"dem", "parallel", CFG_ENUM, "auto", 1, 0, "auto|replicated|split",
      "several ranks: every rank computes everything (replicated), or the pairs are shared and the forces summed "
      "(split); auto: split from 4000 particles"},
-    {"dem", "t_end", CFG_DOUBLE, NULL, 0, BIG, NULL, "end time of the run (s)"},
+    {"dem", "substeps", CFG_INT, "100", 1, 100000000, NULL,
+     "ibmdem run, scene without fluid: DEM steps per step of the run driver (its outputs and checks)"},
     {"dem", "max_overlap", CFG_DOUBLE, "0.01", 1e-9, 1, NULL,
      "stop (with a checkpoint) when an overlap exceeds this fraction of the smaller diameter"},
-    {"dem", "output_interval", CFG_DOUBLE, "0", 0, BIG, NULL, "time between particle snapshots (s); 0: first and last"},
     {"dem", "series_interval", CFG_DOUBLE, "0", 0, BIG, NULL,
-     "time between lines of the time series (s); 0: t_end/500"},
-    {"dem", "stop_at_rest", CFG_BOOL, "false", 1, 0, NULL,
-     "end the run when the kinetic energy per mobile particle < rest_energy × m g d"},
-    {"dem", "rest_energy", CFG_DOUBLE, "1e-7", 0, BIG, NULL, "rest criterion of stop_at_rest (see packing.rest_energy)"},
-    {"dem", "rest_after", CFG_DOUBLE, "0", 0, BIG, NULL, "stop_at_rest is only checked after this time (s)"},
+     "dem_run_case: time between lines of dem_series.csv (s); 0: t_end/500"},
+    {"dem", "rest_after", CFG_DOUBLE, "0", 0, BIG, NULL,
+     "the grains' rate of change (rms velocity / mean diameter) counts for time.steady_tol after this time (s)"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL}};
 
 void dem_register_keys(void) { cfg_schema_add(dem_keys); }

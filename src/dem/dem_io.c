@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "dem_private.h"
 #include "util.h"
@@ -175,6 +176,20 @@ static void write_particles(dem_t *d, hid_t f, int full)
     free(o);
 }
 
+static void snap_record(dem_t *d, int index, double t, long n)
+{
+    if (d->nsnap == d->snap_cap) {
+        d->snap_cap = d->snap_cap ? 2 * d->snap_cap : 64;
+        d->snap_t = realloc(d->snap_t, (size_t)d->snap_cap * sizeof(double));
+        d->snap_n = realloc(d->snap_n, (size_t)d->snap_cap * sizeof(long));
+        d->snap_index = realloc(d->snap_index, (size_t)d->snap_cap * sizeof(int));
+    }
+    d->snap_t[d->nsnap] = t;
+    d->snap_n[d->nsnap] = n;
+    d->snap_index[d->nsnap] = index;
+    d->nsnap++;
+}
+
 static void write_xdmf(dem_t *d, const char *dir)
 {
     if (d->rank != 0) return;
@@ -213,6 +228,21 @@ static void write_xdmf(dem_t *d, const char *dir)
     fclose(fp);
 }
 
+void dem_snapshots_resume(dem_t *d, const char *dir, int first)
+{
+    for (int k = 0; k < first; k++) {
+        char path[4096];
+        snprintf(path, sizeof path, "%s/particles_%06d.h5", dir, k);
+        if (access(path, R_OK) != 0) continue;
+        hid_t f = open_file(d, path, 0);
+        double t = 0;
+        read_attr_d(f, "time", &t);
+        const long n = ds_length(f, "radius");
+        H5Fclose(f);
+        snap_record(d, k, t, n);
+    }
+}
+
 void dem_write_snapshot(dem_t *d, const char *dir, int index)
 {
     dem_sync_velocities(d);
@@ -223,20 +253,18 @@ void dem_write_snapshot(dem_t *d, const char *dir, int index)
     write_attr_l(f, "step", d->step);
     write_particles(d, f, 0);
     H5Fclose(f);
-    if (d->nsnap == d->snap_cap) {
-        d->snap_cap = d->snap_cap ? 2 * d->snap_cap : 64;
-        d->snap_t = realloc(d->snap_t, (size_t)d->snap_cap * sizeof(double));
-        d->snap_n = realloc(d->snap_n, (size_t)d->snap_cap * sizeof(long));
-        d->snap_index = realloc(d->snap_index, (size_t)d->snap_cap * sizeof(int));
-    }
-    d->snap_t[d->nsnap] = d->time;
-    d->snap_n[d->nsnap] = d->n;
-    d->snap_index[d->nsnap] = index;
-    d->nsnap++;
+    snap_record(d, index, d->time, d->n);
     write_xdmf(d, dir);
 }
 
 void dem_write_checkpoint(dem_t *d, const char *path)
+{
+    hid_t f = open_file(d, path, 1);
+    dem_checkpoint_write_loc(d, f);
+    H5Fclose(f);
+}
+
+void dem_checkpoint_write_loc(dem_t *d, hid_t f)
 {
     dem_sync_velocities(d);
     /* histories live on their owner rank: share them first */
@@ -247,7 +275,6 @@ void dem_write_checkpoint(dem_t *d, const char *path)
         dem_neigh_build(d);
         d->sort_every = sort;
     }
-    hid_t f = open_file(d, path, 1);
     write_attr_d(f, "time", &d->time, 1);
     write_attr_l(f, "step", d->step);
     write_attr_d(f, "gravity", d->gravity, 3);
@@ -302,7 +329,6 @@ void dem_write_checkpoint(dem_t *d, const char *path)
         free(wxi);
         H5Gclose(g);
     }
-    H5Fclose(f);
 }
 
 static int cmp_long(const void *a, const void *b)
@@ -314,6 +340,12 @@ static int cmp_long(const void *a, const void *b)
 void dem_read_checkpoint(dem_t *d, const char *path)
 {
     hid_t f = open_file(d, path, 0);
+    dem_checkpoint_read_loc(d, f, path);
+    H5Fclose(f);
+}
+
+void dem_checkpoint_read_loc(dem_t *d, hid_t f, const char *path)
+{
     const long n = ds_length(f, "radius");
     double *x = malloc((3 * (size_t)n + 1) * sizeof(double)), *v = malloc((3 * (size_t)n + 1) * sizeof(double)),
            *w = malloc((3 * (size_t)n + 1) * sizeof(double)), *r = malloc(((size_t)n + 1) * sizeof(double)),
@@ -444,7 +476,6 @@ void dem_read_checkpoint(dem_t *d, const char *path)
     }
     free(sorted);
     free(index_of);
-    H5Fclose(f);
     free(x);
     free(v);
     free(w);

@@ -7,6 +7,26 @@
 #include "dem_private.h"
 #include "util.h"
 
+/* Rate of change of the grains: rms velocity / mean diameter (1/s) of the
+ * mobile particles, INFINITY before `after` (time.steady_tol, as the fluid's
+ * relative rate of change per unit time). */
+double dem_rest_rate(dem_t *d, double after)
+{
+    if (d->time < after) return INFINITY;
+    dem_diag_t g;
+    dem_diag_light(d, &g);
+    double msum = 0, dsum = 0;
+    long nm = 0;
+    for (int i = 0; i < d->n; i++)
+        if (!d->fixed[i]) {
+            msum += 1.0 / d->invm[i];
+            dsum += 2 * d->r[i];
+            nm++;
+        }
+    if (nm == 0) return 0;
+    return sqrt(2 * g.ke_trans / msum) / (dsum / nm);
+}
+
 /* Kinetic energy per mobile particle relative to m̄ g d̄ (rest criterion). */
 static double rest_measure(dem_t *d, const double g[3])
 {
@@ -115,11 +135,10 @@ int dem_run_case(cfg_t *cfg, const char *outdir)
 {
     if (mpi_rank() == 0 && mkdir_p(outdir) != 0) die("cannot create output directory %s", outdir);
     MPI_Barrier(MPI_COMM_WORLD);
-    const double t_end = cfg_double(cfg, "dem", "t_end");
-    double out_dt = cfg_double(cfg, "dem", "output_interval");
+    const double t_end = cfg_double(cfg, "time", "t_end");
+    double out_dt = cfg_double(cfg, "output", "fields_every");
     double ser_dt = cfg_double(cfg, "dem", "series_interval");
-    const int stop_rest = cfg_bool(cfg, "dem", "stop_at_rest");
-    const double rest_crit = cfg_double(cfg, "dem", "rest_energy");
+    const double steady_tol = cfg_double(cfg, "time", "steady_tol");
     const double rest_after = cfg_double(cfg, "dem", "rest_after");
     dem_t *d = dem_create_from_config(cfg, MPI_COMM_WORLD);
     if (d->n == 0) die("dem: the scene has no particles");
@@ -167,7 +186,7 @@ int dem_run_case(cfg_t *cfg, const char *outdir)
         if (d->time >= next_ser * (1 - 1e-12)) {
             series_line(d, ser);
             next_ser += ser_dt;
-            if (stop_rest && d->time >= rest_after && rest_measure(d, d->gravity) < rest_crit) {
+            if (steady_tol > 0 && dem_rest_rate(d, rest_after) < steady_tol) {
                 at_rest = 1;
                 msg("dem: at rest at t = %g s\n", d->time);
             }
