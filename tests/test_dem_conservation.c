@@ -1,5 +1,5 @@
 /* test_dem_conservation.c — conservation laws of the DEM integrator.
- * RANKS: 1 2
+ * RANKS: 1
  *
  *  - energy: elastic frictionless spheres (e = 1, μ_c = 0) in a triply
  *    periodic box; the total energy Σ ½mv² + ½Iω² + Σ ½k_nδ² is followed
@@ -15,8 +15,8 @@
  *    with dt and |drift| < 3e-6 at t_c/dt = 400.
  *  - momentum: a dissipative, frictional gas with rolling resistance in the
  *    periodic box: Σ m v is constant to round-off (every pair force is
- *    applied with opposite signs, across periodic images too).  Run with the
- *    pairs split among the ranks (forces summed) on 2 ranks.
+ *    applied with opposite signs, across periodic images too).  (The pairs
+ *    split among ranks: tests/test_dem_lists.c, with momentum.)
  */
 #include <stdlib.h>
 

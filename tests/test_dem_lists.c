@@ -221,6 +221,31 @@ static void test_reproducible_and_split(void **state)
     dem_free(c);
 }
 
+/* Momentum of a frictional, dissipative gas in a periodic box with the pairs
+ * split over the ranks: constant to round-off (each pair force is summed
+ * into both particles, whichever rank computed it). */
+static void test_split_momentum(void **state)
+{
+    dem_t *d = scene("0.012 0.012 0.012", "", 100, 2.0, "parallel = split", MPI_COMM_WORLD, 0.0);
+    assert_int_equal(dem_step(d), DEM_OK);
+    dem_diag_t g0, g;
+    dem_diag(d, &g0);
+    for (int s = 0; s < 2000; s++) assert_int_equal(dem_step(d), DEM_OK);
+    dem_diag(d, &g);
+    double pm = 0, dp = 0;
+    for (int i = 0; i < dem_count(d); i++) {
+        double v2 = 0;
+        for (int a = 0; a < 3; a++) v2 += dem_velocities(d)[3 * i + a] * dem_velocities(d)[3 * i + a];
+        pm += sqrt(v2) * dem_mass(d, i);
+    }
+    for (int a = 0; a < 3; a++) dp = fmax(dp, fabs(g.momentum[a] - g0.momentum[a]));
+    printf("  split gas: %ld contacts started, |dP| = %.2e, Sum m|v| = %.2e kg m/s\n",
+           g.contacts_started - g0.contacts_started, dp, pm);
+    assert_true(g.contacts_started - g0.contacts_started > 20);
+    assert_true(dp < 1e-13 * pm);
+    dem_free(d);
+}
+
 int main(int argc, char **argv)
 {
     test_mpi_init(&argc, &argv);
@@ -231,6 +256,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_list_walls),
         cmocka_unit_test(test_history_kept),
         cmocka_unit_test(test_reproducible_and_split),
+        cmocka_unit_test(test_split_momentum),
     };
     TEST_MPI_RUN("dem_lists", tests);
 }

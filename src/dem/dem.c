@@ -410,9 +410,17 @@ dem_status_t dem_advance(dem_t *d, double t_target)
     if (!d->ready && (st = dem_setup(d)) != DEM_OK) return st;
     const double span = t_target - d->time;
     if (span <= 0) return DEM_OK;
-    const long nsteps = (long)ceil(span / d->dt * (1 - 1e-12));
+    /* a whole number of steps (to round-off, e.g. a driver step of `substeps`
+     * DEM steps) is done with the step itself, so that the run does not
+     * depend on the round-off of the caller's time; else equal shorter steps */
+    const double ratio = span / d->dt;
+    long nsteps = lround(ratio);
     const double dt_save = d->dt;
-    d->dt = span / (double)(nsteps > 0 ? nsteps : 1);
+    if (nsteps < 1 || fabs(ratio - (double)nsteps) > 1e-6) {
+        nsteps = (long)ceil(ratio * (1 - 1e-12));
+        if (nsteps < 1) nsteps = 1;
+        d->dt = span / (double)nsteps;
+    }
     for (long s = 0; s < nsteps && st == DEM_OK; s++) st = step_once(d);
     double t0 = wtime();
     dem_sync_velocities(d);

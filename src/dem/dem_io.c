@@ -134,9 +134,14 @@ static double *gather1(const dem_t *d, const double *a, const int *o)
     return b;
 }
 
+/* Snapshots: particles in id order.  Checkpoints (full): in the current
+ * index order, with the neighbour lists, so that a reloaded run continues
+ * bit for bit. */
 static void write_particles(dem_t *d, hid_t f, int full)
 {
     int *o = id_order(d);
+    if (full)
+        for (int i = 0; i < d->n; i++) o[i] = i;
     double *b;
     b = gather3(d, d->x, o);
     write_ds(d, f, "position", H5T_NATIVE_DOUBLE, b, d->n, 3);
@@ -267,14 +272,9 @@ void dem_write_checkpoint(dem_t *d, const char *path)
 void dem_checkpoint_write_loc(dem_t *d, hid_t f)
 {
     dem_sync_velocities(d);
-    /* histories live on their owner rank: share them first */
-    if (d->split && d->nb_start) {
-        /* a rebuild gathers them; do it without moving anything */
-        const int sort = d->sort_every;
-        d->sort_every = 0;
-        dem_neigh_build(d);
-        d->sort_every = sort;
-    }
+    /* springs live on their owner rank: share them first (the lists are
+     * not changed: a checkpoint does not change the run) */
+    if (d->split && d->nb_start) dem_neigh_gather(d);
     write_attr_d(f, "time", &d->time, 1);
     write_attr_l(f, "step", d->step);
     write_attr_d(f, "gravity", d->gravity, 3);
@@ -327,7 +327,24 @@ void dem_checkpoint_write_loc(dem_t *d, hid_t f)
         write_ds(d, g, "xi", H5T_NATIVE_DOUBLE, wxi, nw, 3);
         free(wid);
         free(wxi);
+        /* the wall's contact list as it is (exact continuation) */
+        const double moved = W->moved;
+        write_attr_d(g, "list_moved", &moved, 1);
+        write_ds(d, g, "list_idx", H5T_NATIVE_INT, W->idx, W->nlist, 1);
+        write_ds(d, g, "list_on", H5T_NATIVE_UCHAR, W->on, W->nlist, 1);
+        write_ds(d, g, "list_xi", H5T_NATIVE_DOUBLE, W->hist, W->nlist, 3);
         H5Gclose(g);
+    }
+    /* the pair list as it is (exact continuation) */
+    if (d->nb_start && d->nb_n_rows == d->n) {
+        const double lattr[3] = {d->skin, d->disp_bound, (double)d->builds_since_sort};
+        write_attr_d(f, "list_skin_disp_sort", lattr, 3);
+        write_attr_l(f, "list_rebuilds", d->rebuilds);
+        write_ds(d, f, "list_start", H5T_NATIVE_INT, d->nb_start, d->n + 1, 1);
+        write_ds(d, f, "list_j", H5T_NATIVE_INT, d->nb_j, d->nb_n, 1);
+        write_ds(d, f, "list_img", H5T_NATIVE_UCHAR, d->nb_img, d->nb_n, 1);
+        write_ds(d, f, "list_on", H5T_NATIVE_UCHAR, d->nb_on, d->nb_n, 1);
+        write_ds(d, f, "list_xi", H5T_NATIVE_DOUBLE, d->nb_hist, d->nb_n, 3);
     }
 }
 
@@ -335,6 +352,81 @@ static int cmp_long(const void *a, const void *b)
 {
     const long x = *(const long *)a, y = *(const long *)b;
     return (x > y) - (x < y);
+}
+
+/* The neighbour and wall lists saved by dem_checkpoint_write_loc, if the
+ * scene matches (same particles in the same order, skin, walls); 0 if not. */
+static int read_exact_lists(dem_t *d, hid_t f)
+{
+    if (!has_ds(f, "list_start") || ds_length(f, "list_start") != d->n + 1) return 0;
+    double lattr[3];
+    if (H5Aexists(f, "list_skin_disp_sort") <= 0) return 0;
+    read_attr_d(f, "list_skin_disp_sort", lattr);
+    if (lattr[0] != d->skin) return 0;
+    for (int w = 0; w < d->nwall; w++) {
+        char name[64];
+        snprintf(name, sizeof name, "wall_%s", d->wall[w].name);
+        if (!has_ds(f, name)) return 0;
+    }
+    const long m = ds_length(f, "list_j");
+    free(d->nb_start);
+    d->nb_start = xcalloc((size_t)d->n + 1, sizeof(int));
+    read_ds(f, "list_start", H5T_NATIVE_INT, d->nb_start);
+    if (m > d->nb_cap) {
+        free(d->nb_j);
+        free(d->nb_img);
+        free(d->nb_on);
+        free(d->nb_hist);
+        d->nb_j = xcalloc((size_t)m, sizeof(int));
+        d->nb_img = xcalloc((size_t)m, 1);
+        d->nb_on = xcalloc((size_t)m, 1);
+        d->nb_hist = xcalloc(3 * (size_t)m, sizeof(double));
+        d->nb_cap = m;
+    }
+    if (m > 0) {
+        read_ds(f, "list_j", H5T_NATIVE_INT, d->nb_j);
+        read_ds(f, "list_img", H5T_NATIVE_UCHAR, d->nb_img);
+        read_ds(f, "list_on", H5T_NATIVE_UCHAR, d->nb_on);
+        read_ds(f, "list_xi", H5T_NATIVE_DOUBLE, d->nb_hist);
+    }
+    d->nb_n = m;
+    d->nb_n_rows = d->n;
+    d->disp_bound = lattr[1];
+    d->builds_since_sort = (int)lattr[2];
+    hid_t a = H5Aopen(f, "list_rebuilds", H5P_DEFAULT);
+    H5Aread(a, H5T_NATIVE_LONG, &d->rebuilds);
+    H5Aclose(a);
+    for (int w = 0; w < d->nwall; w++) {
+        dem_wall_t *W = &d->wall[w];
+        char name[64];
+        snprintf(name, sizeof name, "wall_%s", W->name);
+        hid_t g = H5Gopen2(f, name, H5P_DEFAULT);
+        double act = 1;
+        read_attr_d(g, "point", W->p);
+        read_attr_d(g, "active", &act);
+        read_attr_d(g, "list_moved", &W->moved);
+        W->active = act != 0;
+        const long nl = ds_length(g, "list_idx");
+        if (nl > W->cap) {
+            free(W->idx);
+            free(W->on);
+            free(W->hist);
+            W->idx = xcalloc((size_t)nl, sizeof(int));
+            W->on = xcalloc((size_t)nl, 1);
+            W->hist = xcalloc(3 * (size_t)nl, sizeof(double));
+            W->cap = (int)nl;
+        }
+        if (nl > 0) {
+            read_ds(g, "list_idx", H5T_NATIVE_INT, W->idx);
+            read_ds(g, "list_on", H5T_NATIVE_UCHAR, W->on);
+            read_ds(g, "list_xi", H5T_NATIVE_DOUBLE, W->hist);
+        }
+        W->nlist = (int)nl;
+        H5Gclose(g);
+    }
+    /* the cell grid is made at the next build; the rows of this rank */
+    dem_neigh_partition(d);
+    return 1;
 }
 
 void dem_read_checkpoint(dem_t *d, const char *path)
@@ -379,11 +471,13 @@ void dem_checkpoint_read_loc(dem_t *d, hid_t f, const char *path)
             H5Aclose(a);
         }
     }
-    /* springs: build the lists, then look the pairs up by id */
+    /* springs: the saved lists if they fit this scene, else build the lists
+     * and look the pairs up by id */
     int restored = 0;
     dem_check_scene(d);
     dem_decide_split(d);
     if (d->dt <= 0 && dem_set_dt(d) != DEM_OK) die("dem: %s", d->errmsg);
+    if (read_exact_lists(d, f)) goto forces;
     dem_neigh_build(d);
     long *sorted = malloc(((size_t)n + 1) * sizeof(long));
     int *index_of = malloc(((size_t)n + 1) * sizeof(int));
@@ -456,26 +550,26 @@ void dem_checkpoint_read_loc(dem_t *d, hid_t f, const char *path)
         free(wxi);
     }
 #undef INDEX_OF
+    free(sorted);
+    free(index_of);
+forces:
     /* forces of the saved state: the next step continues exactly as the run
-     * that wrote the file would have (up to the order of the force sums) */
+     * that wrote the file would have */
     if (has_ds(f, "force") && has_ds(f, "torque")) {
         double *ff = malloc((3 * (size_t)n + 1) * sizeof(double)), *tt = malloc((3 * (size_t)n + 1) * sizeof(double));
         read_ds(f, "force", H5T_NATIVE_DOUBLE, ff);
         read_ds(f, "torque", H5T_NATIVE_DOUBLE, tt);
         for (int i = 0; i < d->n; i++) {
-            /* the file holds the particles in id order */
-            const long k = (long *)bsearch(&d->id[i], ids, (size_t)n, sizeof(long), cmp_long) - ids;
+            /* the particles were added in the order of the file */
             for (int c = 0; c < 3; c++) {
-                d->f[3 * i + c] = ff[3 * k + c];
-                d->t[3 * i + c] = tt[3 * k + c];
+                d->f[3 * i + c] = ff[3 * i + c];
+                d->t[3 * i + c] = tt[3 * i + c];
             }
         }
         free(ff);
         free(tt);
         restored = 1;
     }
-    free(sorted);
-    free(index_of);
     free(x);
     free(v);
     free(w);

@@ -91,10 +91,10 @@ static void partition_of(const dem_t *d, int q, int *lo, int *hi)
 void dem_neigh_partition(dem_t *d) { partition_of(d, d->rank, &d->row_lo, &d->row_hi); }
 
 /* Every rank updated the histories of its own rows only: share them. */
-static void gather_histories(dem_t *d)
+void dem_neigh_gather(dem_t *d)
 {
     const int P = d->nranks;
-    int *cnt = malloc(2 * (size_t)P * sizeof(int)), *dsp = cnt + P;
+    int *cnt = calloc(2 * (size_t)P + 2, sizeof(int)), *dsp = cnt + P;
     for (int q = 0; q < P; q++) {
         int lo, hi;
         partition_of(d, q, &lo, &hi);
@@ -173,7 +173,7 @@ dem_status_t dem_neigh_build(dem_t *d)
 {
     const double t0 = wtime();
     const int n = d->n;
-    if (d->split && d->nb_start) gather_histories(d);
+    if (d->split && d->nb_start) dem_neigh_gather(d);
 
     /* 1. wrap periodic coordinates, check the domain */
     for (int i = 0; i < n; i++) {

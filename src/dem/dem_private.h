@@ -157,6 +157,8 @@ struct dem {
  * DEM_ERR_LEFT_DOMAIN / DEM_ERR_NAN (message in d->errmsg). */
 dem_status_t dem_neigh_build(dem_t *d);
 void dem_neigh_free(dem_t *d);
+/* Split runs: every rank gets the springs of every pair and wall contact. */
+void dem_neigh_gather(dem_t *d);
 /* The rank's share of the rows after a build. */
 void dem_neigh_partition(dem_t *d);
 
