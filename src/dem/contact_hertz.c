@@ -53,11 +53,8 @@ static void hertz_setup(dem_t *d, cfg_t *cfg)
 static double hertz_contact_time(const dem_t *d)
 {
     const dem_contact_prm_t *cp = &d->cp;
-    double mmin = INFINITY, rmin = INFINITY;
-    for (int i = 0; i < d->n; i++) {
-        if (d->invm[i] > 0.0 && 1.0 / d->invm[i] < mmin) mmin = 1.0 / d->invm[i];
-        if (d->r[i] < rmin) rmin = d->r[i];
-    }
+    double rmin;
+    const double mmin = dem_lightest_mass(d, &rmin);
     if (!isfinite(mmin)) return INFINITY;
     const double meff = 0.5 * mmin, reff = 0.5 * rmin;
     return 2.868 * pow(meff * meff / (reff * cp->E_star * cp->E_star * cp->v_ref), 0.2);

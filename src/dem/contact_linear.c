@@ -152,10 +152,8 @@ static void linear_setup(dem_t *d, cfg_t *cfg)
 static double linear_contact_time(const dem_t *d)
 {
     const dem_contact_prm_t *cp = &d->cp;
-    double mmin = INFINITY;
-    for (int i = 0; i < d->n; i++)
-        if (d->invm[i] > 0.0 && 1.0 / d->invm[i] < mmin) mmin = 1.0 / d->invm[i];
-    if (!isfinite(mmin)) mmin = 1.0;
+    double mmin = dem_lightest_mass(d, NULL);
+    if (!isfinite(mmin)) mmin = 1.0; /* no particle yet: restitution parameters do not depend on it */
     /* the shortest contact: the lightest pair (m* = m_min/2) */
     const double meff = 0.5 * mmin;
     const double K = cp->kn_abs / meff + cp->kn_rel, G = cp->gn_rel;

@@ -149,6 +149,17 @@ void dem_free(dem_t *d)
 
 /* ---- time step ---- */
 
+double dem_lightest_mass(const dem_t *d, double *rmin)
+{
+    double mmin = INFINITY, r = INFINITY;
+    for (int i = 0; i < d->n; i++) {
+        if (d->invm[i] > 0.0 && 1.0 / d->invm[i] < mmin) mmin = 1.0 / d->invm[i];
+        if (d->r[i] < r) r = d->r[i];
+    }
+    if (rmin) *rmin = r;
+    return mmin;
+}
+
 dem_status_t dem_set_dt(dem_t *d)
 {
     d->tc = d->law->contact_time(d);

@@ -515,7 +515,6 @@ dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
     const double mw = cfg_double(cfg, "contact", "wall_friction");
     cp->mu_wall = mw < 0 ? cp->mu : mw;
     cp->mu_roll = cfg_double(cfg, "contact", "rolling_friction");
-    cp->mu_settle = -1;
     d->law->setup(d, cfg);
     /* integration and neighbour search */
     cfg_vec3(cfg, "dem", "gravity", d->gravity);

@@ -119,21 +119,6 @@ static int *id_order(const dem_t *d)
     return o;
 }
 
-static double *gather3(const dem_t *d, const double *a, const int *o)
-{
-    double *b = malloc((3 * (size_t)d->n + 1) * sizeof(double));
-    for (int k = 0; k < d->n; k++)
-        for (int c = 0; c < 3; c++) b[3 * k + c] = a[3 * o[k] + c];
-    return b;
-}
-
-static double *gather1(const dem_t *d, const double *a, const int *o)
-{
-    double *b = malloc(((size_t)d->n + 1) * sizeof(double));
-    for (int k = 0; k < d->n; k++) b[k] = a[o[k]];
-    return b;
-}
-
 /* Snapshots: particles in id order.  Checkpoints (full): in the current
  * index order, with the neighbour lists, so that a reloaded run continues
  * bit for bit. */
@@ -142,21 +127,20 @@ static void write_particles(dem_t *d, hid_t f, int full)
     int *o = id_order(d);
     if (full)
         for (int i = 0; i < d->n; i++) o[i] = i;
-    double *b;
-    b = gather3(d, d->x, o);
-    write_ds(d, f, "position", H5T_NATIVE_DOUBLE, b, d->n, 3);
-    free(b);
-    b = gather3(d, d->v, o);
-    write_ds(d, f, "velocity", H5T_NATIVE_DOUBLE, b, d->n, 3);
-    free(b);
-    b = gather3(d, d->w, o);
-    write_ds(d, f, "omega", H5T_NATIVE_DOUBLE, b, d->n, 3);
-    free(b);
-    b = gather1(d, d->r, o);
-    write_ds(d, f, "radius", H5T_NATIVE_DOUBLE, b, d->n, 1);
-    free(b);
-    b = gather1(d, d->rho, o);
-    write_ds(d, f, "density", H5T_NATIVE_DOUBLE, b, d->n, 1);
+    const struct {
+        const char *name;
+        const double *a;
+        int comp;
+    } arrays[] = {{"position", d->x, 3}, {"velocity", d->v, 3}, {"omega", d->w, 3},   {"radius", d->r, 1},
+                  {"density", d->rho, 1}, {"force", d->f, 3},   {"torque", d->t, 3}};
+    /* force and torque (the integrator's state) in checkpoints only */
+    const int narr = full ? 7 : 5;
+    double *b = malloc((3 * (size_t)d->n + 1) * sizeof(double));
+    for (int a = 0; a < narr; a++) {
+        for (int k = 0; k < d->n; k++)
+            for (int c = 0; c < arrays[a].comp; c++) b[arrays[a].comp * k + c] = arrays[a].a[arrays[a].comp * o[k] + c];
+        write_ds(d, f, arrays[a].name, H5T_NATIVE_DOUBLE, b, d->n, arrays[a].comp);
+    }
     free(b);
     long *ids = malloc(((size_t)d->n + 1) * sizeof(long));
     int *fx = malloc(((size_t)d->n + 1) * sizeof(int));
@@ -166,16 +150,6 @@ static void write_particles(dem_t *d, hid_t f, int full)
     }
     write_ds(d, f, "id", H5T_NATIVE_LONG, ids, d->n, 1);
     write_ds(d, f, "fixed", H5T_NATIVE_INT, fx, d->n, 1);
-    if (full) {
-        /* the state of the integrator: forces of the current positions and
-         * the predictor increments (bit-for-bit restart) */
-        b = gather3(d, d->f, o);
-        write_ds(d, f, "force", H5T_NATIVE_DOUBLE, b, d->n, 3);
-        free(b);
-        b = gather3(d, d->t, o);
-        write_ds(d, f, "torque", H5T_NATIVE_DOUBLE, b, d->n, 3);
-        free(b);
-    }
     free(ids);
     free(fx);
     free(o);

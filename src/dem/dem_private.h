@@ -40,7 +40,6 @@ typedef struct {
     double kt_ratio;     /* linear: k_t = kt_ratio k_n */
     double mu, mu_wall;  /* Coulomb friction: particle–particle, particle–wall */
     double mu_roll;      /* rolling resistance coefficient (constant torque), 0 = off */
-    double mu_settle;    /* (packing) friction temporarily used while settling; <0: unused */
     /* linear spring–dashpot: F_n = (kn_abs + m* kn_rel) δ + m* gn_rel δ̇ */
     double kn_abs, kn_rel, gn_rel;
     double restitution, tc_given;
@@ -168,6 +167,8 @@ dem_status_t dem_set_dt(dem_t *d);
 /* Checks that need the particles (periodic lengths); sets the skin and image shifts. */
 void dem_check_scene(dem_t *d);
 void dem_decide_split(dem_t *d);
+/* Mass of the lightest mobile particle (INFINITY if none); smallest radius in *rmin. */
+double dem_lightest_mass(const dem_t *d, double *rmin);
 void dem_compute_forces(dem_t *d);
 /* Finish a pending half kick so that v, w are full-step values. */
 void dem_sync_velocities(dem_t *d);

@@ -7,6 +7,22 @@
 #include "dem_private.h"
 #include "util.h"
 
+/* Mean mass and mean diameter of the mobile particles; their number. */
+static long mobile_means(const dem_t *d, double *m, double *dia)
+{
+    double msum = 0, dsum = 0;
+    long nm = 0;
+    for (int i = 0; i < d->n; i++)
+        if (!d->fixed[i]) {
+            msum += 1.0 / d->invm[i];
+            dsum += 2 * d->r[i];
+            nm++;
+        }
+    *m = nm ? msum / nm : 0;
+    *dia = nm ? dsum / nm : 0;
+    return nm;
+}
+
 /* Rate of change of the grains: rms velocity / mean diameter (1/s) of the
  * mobile particles, INFINITY before `after` (time.steady_tol, as the fluid's
  * relative rate of change per unit time). */
@@ -15,35 +31,20 @@ double dem_rest_rate(dem_t *d, double after)
     if (d->time < after) return INFINITY;
     dem_diag_t g;
     dem_diag_light(d, &g);
-    double msum = 0, dsum = 0;
-    long nm = 0;
-    for (int i = 0; i < d->n; i++)
-        if (!d->fixed[i]) {
-            msum += 1.0 / d->invm[i];
-            dsum += 2 * d->r[i];
-            nm++;
-        }
-    if (nm == 0) return 0;
-    return sqrt(2 * g.ke_trans / msum) / (dsum / nm);
+    double m, dia;
+    const long nm = mobile_means(d, &m, &dia);
+    return nm ? sqrt(2 * g.ke_trans / (nm * m)) / dia : 0.0;
 }
 
 /* Kinetic energy per mobile particle relative to m̄ g d̄ (rest criterion). */
 static double rest_measure(dem_t *d, const double g[3])
 {
     dem_diag_t dg;
-    dem_diag(d, &dg);
-    double msum = 0, dsum = 0;
-    long nm = 0;
-    for (int i = 0; i < d->n; i++)
-        if (!d->fixed[i]) {
-            msum += 1.0 / d->invm[i];
-            dsum += 2 * d->r[i];
-            nm++;
-        }
-    if (nm == 0) return 0;
+    dem_diag_light(d, &dg);
+    double m, dia;
+    const long nm = mobile_means(d, &m, &dia);
     const double gm = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-    const double scale = (msum / nm) * (gm > 0 ? gm : 1.0) * (dsum / nm);
-    return (dg.ke_trans + dg.ke_rot) / nm / scale;
+    return nm ? (dg.ke_trans + dg.ke_rot) / nm / (m * (gm > 0 ? gm : 1.0) * dia) : 0.0;
 }
 
 int dem_prepare_packing(dem_t *d, cfg_t *cfg, const char *outdir)
