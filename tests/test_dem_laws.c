@@ -9,6 +9,8 @@
  *    to e without the clip (the β(e) relation is that of the linear
  *    oscillator); checked within 5 %.  With the clip the restitution is
  *    higher (reported).
+ *  - Moving wall: a wall (infinite mass) moving at V hits a sphere at rest,
+ *    which leaves at (1 + e) V.
  *  - Rolling resistance: a sphere rolling without slip on a horizontal wall
  *    under a constant resisting torque μ_r R m g decelerates at
  *    (5/7) μ_r g (m a = F, (2/5) m R² α = −F R − μ_r R m g, a = α R).
@@ -113,6 +115,33 @@ static void test_rolling_resistance(void **state)
     dem_free(d);
 }
 
+static void test_moving_wall(void **state)
+{
+    const double V = 0.3, e = 0.87;
+    char text[1024];
+    snprintf(text, sizeof text,
+             "[domain]\nlength = 0.02 0.02 0.02\n[boundary]\nz_lo = noslip\nz_hi = noslip\n[walls]\nfaces = none\n"
+             "wall1_point = 0 0 0.002\nwall1_normal = 0 0 1\nwall1_velocity = 0 0 %g\n"
+             "[contact]\nrestitution = %g\ncontact_time = 1e-4\nfriction = 0.3\n[dem]\ngravity = 0 0 0\n",
+             V, e);
+    cfg_t *cfg = cfg_load_string("piston.ini", text, 0, NULL);
+    assert_non_null(cfg);
+    dem_t *d = dem_create_from_config(cfg, MPI_COMM_WORLD);
+    const double x[3] = {0.01, 0.01, 0.002 + R + 0.37 * V * 2e-6 * 7}, v[3] = {0, 0, 0};
+    dem_add_particle(d, x, v, R, RHO, 0);
+    for (int s = 0; s < 400; s++) assert_int_equal(dem_step(d), DEM_OK);
+    const double vz = dem_velocities(d)[2];
+    double fw[3];
+    dem_wall_force(d, 0, fw);
+    printf("  wall moving at %.2f m/s, e = %.2f: sphere leaves at %.5f m/s, (1 + e) V = %.5f (%+.3f %%)\n", V, e, vz,
+           (1 + e) * V, 100 * (vz / ((1 + e) * V) - 1));
+    /* the restitution test's accuracy at t_c/dt = 50 */
+    assert_true(fabs(vz / ((1 + e) * V) - 1) < 2e-3);
+    assert_true(fw[2] == 0.0); /* separated */
+    dem_free(d);
+    cfg_free(cfg);
+}
+
 int main(int argc, char **argv)
 {
     test_mpi_init(&argc, &argv);
@@ -121,6 +150,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_hertz_elastic),
         cmocka_unit_test(test_hertz_damped),
         cmocka_unit_test(test_rolling_resistance),
+        cmocka_unit_test(test_moving_wall),
     };
     TEST_MPI_RUN("dem_laws", tests);
 }
