@@ -11,6 +11,9 @@
  *    higher (reported).
  *  - Moving wall: a wall (infinite mass) moving at V hits a sphere at rest,
  *    which leaves at (1 + e) V.
+ *  - External force and torque (the immersed boundary's input), held
+ *    constant while sub-cycling with dem_advance: v = F t/m and ω = Γ t/I,
+ *    exact for velocity Verlet under constant forces.
  *  - Rolling resistance: a sphere rolling without slip on a horizontal wall
  *    under a constant resisting torque μ_r R m g decelerates at
  *    (5/7) μ_r g (m a = F, (2/5) m R² α = −F R − μ_r R m g, a = α R).
@@ -142,6 +145,28 @@ static void test_moving_wall(void **state)
     cfg_free(cfg);
 }
 
+static void test_external_force(void **state)
+{
+    dem_t *d = wall_scene("restitution = 0.5\ncontact_time = 1e-4\nfriction = 0.3", 0.0);
+    const double x[3] = {0.01, 0.01, 0.01}, v[3] = {0, 0, 0};
+    dem_add_particle(d, x, v, R, RHO, 0);
+    const double m = dem_mass(d, 0), I = 0.4 * m * R * R;
+    double *fe = dem_ext_force(d), *te = dem_ext_torque(d);
+    fe[0] = 1e-6;
+    te[2] = 1e-10;
+    /* three "fluid steps" of 1.37e-4 s: not a multiple of the DEM step */
+    for (int k = 1; k <= 3; k++) assert_int_equal(dem_advance(d, k * 1.37e-4), DEM_OK);
+    const double t = dem_time(d), vx = dem_velocities(d)[0], wz = dem_omegas(d)[2], xx = dem_positions(d)[0];
+    printf("  external force: t = %.6g s, v = %.6e (F t/m = %.6e), omega = %.6e (T t/I = %.6e), x - x0 = %.6e "
+           "(F t^2/2m = %.6e)\n",
+           t, vx, 1e-6 * t / m, wz, 1e-10 * t / I, xx - 0.01, 0.5e-6 * t * t / m);
+    assert_true(fabs(t - 3 * 1.37e-4) < 1e-15);
+    assert_true(fabs(vx / (1e-6 * t / m) - 1) < 1e-12);
+    assert_true(fabs(wz / (1e-10 * t / I) - 1) < 1e-12);
+    assert_true(fabs((xx - 0.01) / (0.5e-6 * t * t / m) - 1) < 1e-8);
+    dem_free(d);
+}
+
 int main(int argc, char **argv)
 {
     test_mpi_init(&argc, &argv);
@@ -151,6 +176,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_hertz_damped),
         cmocka_unit_test(test_rolling_resistance),
         cmocka_unit_test(test_moving_wall),
+        cmocka_unit_test(test_external_force),
     };
     TEST_MPI_RUN("dem_laws", tests);
 }
