@@ -44,6 +44,9 @@ static void tgv_run(int N, double nu, int implicit, double T, double *erms, doub
     double ke_exact = M_PI * M_PI * exp(-4 * nu * T);
     *eke = fabs(fluid_kinetic_energy(f) - ke_exact) / ke_exact;
     *div = f->diag.div_max;
+    /* the energy of the diagnostics (accumulated during the last projection)
+     * is that of the field */
+    assert_true(fabs(f->diag.ke - fluid_kinetic_energy(f)) < 1e-13 * f->diag.ke);
     fluid_free(f);
     grid_free(g);
 }
