@@ -11,8 +11,7 @@ typedef struct {
                             * solvers when implicit, the operator alone when explicit */
     double *dudt[3];       /* explicit right-hand side of the current RK stage */
     double *dudt_old[3];   /* ... of the previous stage (the ζ term) */
-    double *phi;           /* pressure correction */
-    double *work;          /* scratch */
+    double *work;          /* scratch: the pressure correction φ, the Helmholtz right-hand sides */
     /* metric of the local x range, index −1..nxl (stored at +1): face and
      * centre area factors (r in axisymmetric geometry, 1 otherwise) */
     double *af, *ac;

@@ -33,9 +33,10 @@ void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, doubl
 {
     const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
-    double *rhs = q->work, *phi = q->phi;
-    fluid_divergence_scaled(f, 1.0 / dt_stage, rhs);
-    if (poisson_solve(q->pp, 0.0, rhs, phi) != 0)
+    /* the right-hand side D(u*)/(αΔt), then φ: solved in place */
+    double *phi = q->work;
+    fluid_divergence_scaled(f, 1.0 / dt_stage, phi);
+    if (poisson_solve(q->pp, 0.0, phi, phi) != 0)
         warn("step %ld: the pressure solve did not converge (residual %.3e)\n", f->step, q->pp->last_residual);
     f->diag.res_poisson = q->pp->last_residual;
     f->diag.it_poisson = q->pp->last_iterations;
@@ -70,11 +71,26 @@ void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, doubl
         if (f->prm.implicit_viscous) {
             /* p += φ − (α Δt ν/2) L φ: the pressure consistent with the
              * Crank–Nicolson predictor (Brown, Cortez & Minion 2001) */
-            poisson_apply(q->pp, 0.0, phi, rhs);
-            double a = 0.5 * dt_stage * f->prm.nu;
-            for (int i = 0; i < g->nxl; i++)
+            const poisson_t *pp = q->pp;
+            double a = 0.5 * dt_stage * f->prm.nu, cy = a * pp->cy, cz = a * pp->cz;
+            long sx = g->sx, sy = g->sy;
+            double *restrict p = f->p;
+            const double *restrict ph = phi;
+            for (int i = 0; i < g->nxl; i++) {
+                int ig = i + g->ix0;
+                /* φ − a L φ with the stencil of poisson.c (φ's ghosts are filled) */
+                double cw = a * pp->cw[ig], ce = a * pp->ce[ig], cd = 1.0 + a * pp->cd[ig] + 2.0 * (cy + cz);
                 FLUID_FOR_LINES(g, i, g->n[1], g->n[2], c0, len)
-                for (long m = c0; m < c0 + len; m++) f->p[m] += phi[m] - a * rhs[m];
+                {
+                    if (g->dim == 3)
+                        for (long m = c0; m < c0 + len; m++)
+                            p[m] += cd * ph[m] - cw * ph[m - sx] - ce * ph[m + sx] - cy * (ph[m + sy] + ph[m - sy]) -
+                                    cz * (ph[m + 1] + ph[m - 1]);
+                    else
+                        for (long m = c0; m < c0 + len; m++)
+                            p[m] += cd * ph[m] - cw * ph[m - sx] - ce * ph[m + sx] - cy * (ph[m + sy] + ph[m - sy]);
+                }
+            }
         } else {
             for (int i = 0; i < g->nxl; i++)
                 FLUID_FOR_LINES(g, i, g->n[1], g->n[2], c0, len)
