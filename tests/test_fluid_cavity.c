@@ -75,13 +75,8 @@ static void cavity_run(int N, int re, int implicit, double cfl, double t_max, co
     char *sets[5] = {s_nx, s_ny, s_nu, s_visc, s_cfl};
     cfg_t *cfg = cfg_load("cases/cavity/cavity.ini", 5, sets);
     if (!cfg) die("cases/cavity/cavity.ini rejected");
-    grid_t *g = grid_create_from_config(cfg, MPI_COMM_WORLD);
-    fluid_params_t prm;
-    fluid_params_from_config(cfg, g, &prm);
-    prm.poisson = ft_poisson_opts();
-    fluid_t *f = fluid_create(g, &prm);
-    fluid_init_from_config(f, cfg);
-    cfg_free(cfg);
+    grid_t *g;
+    fluid_t *f = ft_from_cfg(cfg, &g);
 
     double *old[2] = {field_alloc(g), field_alloc(g)}, t_old = 0, w0 = MPI_Wtime(), divmax = 0;
     int steps = 0;
