@@ -100,6 +100,13 @@ void poisson_fill_ghosts(const poisson_t *p, double *x);
 /* Is (i,j,k) (local) an unknown of this location? */
 int poisson_is_unknown(const poisson_t *p, int i, int j, int k);
 
+/* Weight of the x unknown ig (global) in the volume-weighted inner product
+ * for which L is symmetric: Σ w (L x) = 0 for every x when L is singular. */
+double poisson_x_weight(const poisson_t *p, int ig);
+/* Weighted mean of the unknowns of f (global), and f += c on the unknowns. */
+double poisson_weighted_mean(const poisson_t *p, const double *f);
+void poisson_add_constant(const poisson_t *p, double *f, double c);
+
 /* Relative residual ||b − (L − λI)x||₂ / ||b||₂ over the unknowns (uses a
  * scratch field; for tests and diagnostics). */
 double poisson_residual(poisson_t *p, double lambda, const double *b, double *x);

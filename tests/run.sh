@@ -5,6 +5,8 @@
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-build}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
+# ranks may share cores with other jobs: yield instead of busy-polling
+export OMPI_MCA_mpi_yield_when_idle=1
 export BUILD
 MPIRUN="mpirun --allow-run-as-root --oversubscribe"
 if [ "$BUILD" = build-san ]; then

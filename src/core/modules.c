@@ -4,10 +4,12 @@
 #include "fluid.h"
 #include "grid.h"
 #include "poisson.h"
+#include "sim.h"
 
 void modules_register_keys(void)
 {
     grid_register_keys();
     poisson_register_keys();
     fluid_register_keys();
+    sim_register_keys();
 }

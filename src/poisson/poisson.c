@@ -212,7 +212,7 @@ void poisson_apply(poisson_t *p, double lambda, double *x, double *y)
 
 /* Volume weight of unknown i (global) for the compatibility condition of a
  * singular problem: Σ w_i (L x)_i = 0 for every x. */
-static double x_weight(const poisson_t *p, int ig)
+double poisson_x_weight(const poisson_t *p, int ig)
 {
     const grid_t *g = p->g;
     if (p->loc == VAR_U) return g->geom == GEOM_AXI ? g->gxf[ig] * g->gdxc[ig] : g->gdxc[ig];
@@ -220,14 +220,14 @@ static double x_weight(const poisson_t *p, int ig)
 }
 
 /* Weighted mean of the unknowns of f. */
-static double weighted_mean(const poisson_t *p, const double *f)
+double poisson_weighted_mean(const poisson_t *p, const double *f)
 {
     const grid_t *g = p->g;
     double s = 0.0, w = 0.0;
     for (int i = 0; i < g->nxl; i++) {
         int ig = i + g->ix0;
         if (ig >= p->nu[0]) continue;
-        double wi = x_weight(p, ig), si = 0.0;
+        double wi = poisson_x_weight(p, ig), si = 0.0;
         for (int j = 0; j < p->nu[1]; j++)
             for (int k = 0; k < p->nu[2]; k++) si += f[G_IDX(g, i, j, k)];
         s += wi * si;
@@ -238,7 +238,7 @@ static double weighted_mean(const poisson_t *p, const double *f)
     return r[0] / r[1];
 }
 
-static void add_constant(const poisson_t *p, double *f, double c)
+void poisson_add_constant(const poisson_t *p, double *f, double c)
 {
     const grid_t *g = p->g;
     for (int i = 0; i < g->nxl; i++) {
@@ -256,14 +256,14 @@ int poisson_solve(poisson_t *p, double lambda, const double *b, double *x)
     int sing = p->singular && lambda == 0.0;
     if (sing) {
         /* Remove the incompatible part (weighted mean) of b. */
-        double m = weighted_mean(p, b);
+        double m = poisson_weighted_mean(p, b);
         tmp = field_alloc(p->g);
         field_copy(p->g, tmp, b);
-        add_constant(p, tmp, -m);
+        poisson_add_constant(p, tmp, -m);
         rhs = tmp;
     }
     int rc = p->backend->solve(p, p->impl, lambda, rhs, x);
-    if (sing) add_constant(p, x, -weighted_mean(p, x));
+    if (sing) poisson_add_constant(p, x, -poisson_weighted_mean(p, x));
     free(tmp);
     return rc;
 }
@@ -274,7 +274,7 @@ double poisson_residual(poisson_t *p, double lambda, const double *b, double *x)
     double *y = field_alloc(g);
     double *bb = field_alloc(g);
     field_copy(g, bb, b);
-    if (p->singular && lambda == 0.0) add_constant(p, bb, -weighted_mean(p, b));
+    if (p->singular && lambda == 0.0) poisson_add_constant(p, bb, -poisson_weighted_mean(p, b));
     poisson_apply(p, lambda, x, y);
     double rr = 0.0, bn = 0.0;
     for (int i = 0; i < g->nxl; i++)
