@@ -22,83 +22,111 @@
  */
 #include "fluid_internal.h"
 
-/* Each kernel below computes, on the unknowns of one component,
- *     out = ca · ∇·(u⊗u) + cv · L u,
- * the explicit right-hand side of a Runge–Kutta stage in one sweep (the
- * viscous part is the stencil of viscous.c, fused here for speed; the tests
- * check that both agree).  The innermost loop runs along a contiguous line
- * (k in 3-D, j in 2-D: FLUID_FOR_LINES) and is written once for 3-D and once
- * for 2-D (is3d is a constant after inlining) so that it vectorises. */
+/* The kernels below compute, on the unknowns of each component, the
+ * advection term N = ∇·(u⊗u) and the Laplacian L u (the stencil of
+ * viscous.c, fused here; the tests check that both agree) and from them the
+ * explicit right-hand side of a Runge–Kutta stage, H = ca·N + cv·L u.  In
+ * the fused mode they also apply the predictor in the same sweep:
+ *     u* = u + dg·H + dz·H_old + α Δt (f − G p) + ce·L u,
+ * written over H_old (which is read at the same point first).  The loops run
+ * plane by plane (i), line by line (j in 3-D), and the three components
+ * inside, so that the lines of u, v, w a line needs are still in cache for
+ * the next component; the innermost loop runs along a contiguous line (k in
+ * 3-D, j in 2-D: FLUID_FOR_LINES) and is instantiated for 3-D and 2-D and
+ * for each mode (is3d, fused are constants after inlining) so that it
+ * vectorises. */
 #define KERNEL static inline __attribute__((always_inline)) void
 
-/* per-i coefficients of a line */
+/* per-i coefficients of a line of one component */
 typedef struct {
     double rv, wa, wb, afw, af0, afe; /* advection metric */
-    double cw, ce, cd, cy, cz, xw;    /* cv · viscous stencil, wall term */
+    double cw, ce, cd, cy, cz, xw;    /* viscous stencil, moving-wall term */
+    double ag, af;                    /* α Δt / Δ of the pressure gradient, α Δt f_c */
 } coef_t;
 
+/* the stage's scalars */
+typedef struct {
+    double ca, cv, dg, dz, ce;
+    const double *p;
+} stage_t;
+
+#define PREDICT(Hd, US, m, h, Lu, sp)                                                                     \
+    do {                                                                                                  \
+        Hd[m] = h;                                                                                        \
+        if (fused) US[m] = q0 + st->dg * h + st->dz * US[m] + k->af - k->ag * (p[m + sp] - p[m]) + st->ce * Lu; \
+    } while (0)
+
 /* u-momentum: control volume a_f,i Δx_c,i × Δy × Δz around face i. */
-KERNEL u_line(const double *restrict u, const double *restrict v, const double *restrict w, double *restrict out,
-              long c0, long len, long sx, long sy, double ca, double rdy, double rdz, const coef_t *k, int is3d)
+KERNEL u_line(const double *restrict u, const double *restrict v, const double *restrict w, double *restrict Hd,
+              double *restrict US, long c0, long len, long sx, long sy, double rdy, double rdz, const coef_t *k,
+              const stage_t *st, int is3d, int fused)
 {
+    const double *restrict p = st->p;
     for (long c = c0; c < c0 + len; c++) {
-        double uc = u[c];
+        double uc = u[c], q0 = uc;
         double Fe = k->af0 * uc + k->afe * u[c + sx], Fw = k->afw * u[c - sx] + k->af0 * uc;
         double X = (Fe * (uc + u[c + sx]) - Fw * (u[c - sx] + uc)) * 0.5 * k->rv;
         double Vn = k->wa * v[c] + k->wb * v[c + sx], Vs = k->wa * v[c - sy] + k->wb * v[c + sx - sy];
         double Y = (Vn * (uc + u[c + sy]) - Vs * (u[c - sy] + uc)) * 0.5 * rdy;
-        double V = k->cw * u[c - sx] + k->ce * u[c + sx] - k->cd * uc + k->cy * (u[c + sy] + u[c - sy]);
+        double Lu = k->cw * u[c - sx] + k->ce * u[c + sx] - k->cd * uc + k->cy * (u[c + sy] + u[c - sy]);
         double Z = 0.0;
         if (is3d) {
             double Wt = k->wa * w[c] + k->wb * w[c + sx], Wb = k->wa * w[c - 1] + k->wb * w[c + sx - 1];
             Z = (Wt * (uc + u[c + 1]) - Wb * (u[c - 1] + uc)) * 0.5 * rdz;
-            V += k->cz * (u[c + 1] + u[c - 1]);
+            Lu += k->cz * (u[c + 1] + u[c - 1]);
         }
-        out[c] = ca * (X + Y + Z) + V;
+        double h = st->ca * (X + Y + Z) + st->cv * Lu;
+        PREDICT(Hd, US, c, h, Lu, sx);
     }
 }
 
 /* v-momentum: control volume a_c,i Δx_f,i × Δy × Δz around y-face j. */
-KERNEL v_line(const double *restrict u, const double *restrict v, const double *restrict w, double *restrict out,
-              long c0, long len, long sx, long sy, double ca, double rdy, double rdz, const coef_t *k, int is3d)
+KERNEL v_line(const double *restrict u, const double *restrict v, const double *restrict w, double *restrict Hd,
+              double *restrict US, long c0, long len, long sx, long sy, double rdy, double rdz, const coef_t *k,
+              const stage_t *st, int is3d, int fused)
 {
+    const double *restrict p = st->p;
     for (long c = c0; c < c0 + len; c++) {
-        double vc = v[c];
+        double vc = v[c], q0 = vc;
         double Ue = k->af0 * (u[c] + u[c + sy]), Uw = k->afw * (u[c - sx] + u[c - sx + sy]);
         double X = (Ue * (vc + v[c + sx]) - Uw * (v[c - sx] + vc)) * k->rv;
         double Vn = vc + v[c + sy], Vs = v[c - sy] + vc;
         double Y = (Vn * Vn - Vs * Vs) * 0.25 * rdy;
-        double V = k->cw * v[c - sx] + k->ce * v[c + sx] - k->cd * vc + k->cy * (v[c + sy] + v[c - sy]) + k->xw;
+        double Lu = k->cw * v[c - sx] + k->ce * v[c + sx] - k->cd * vc + k->cy * (v[c + sy] + v[c - sy]) + k->xw;
         double Z = 0.0;
         if (is3d) {
             double Wt = w[c] + w[c + sy], Wb = w[c - 1] + w[c - 1 + sy];
             Z = (Wt * (vc + v[c + 1]) - Wb * (v[c - 1] + vc)) * 0.25 * rdz;
-            V += k->cz * (v[c + 1] + v[c - 1]);
+            Lu += k->cz * (v[c + 1] + v[c - 1]);
         }
-        out[c] = ca * (X + Y + Z) + V;
+        double h = st->ca * (X + Y + Z) + st->cv * Lu;
+        PREDICT(Hd, US, c, h, Lu, sy);
     }
 }
 
 /* w-momentum (3-D only): control volume Δx_f,i × Δy × Δz around z-face k. */
-KERNEL w_line(const double *restrict u, const double *restrict v, const double *restrict w, double *restrict out,
-              long c0, long len, long sx, long sy, double ca, double rdy, double rdz, const coef_t *k)
+KERNEL w_line(const double *restrict u, const double *restrict v, const double *restrict w, double *restrict Hd,
+              double *restrict US, long c0, long len, long sx, long sy, double rdy, double rdz, const coef_t *k,
+              const stage_t *st, int fused)
 {
+    const double *restrict p = st->p;
     for (long c = c0; c < c0 + len; c++) {
-        double wc = w[c];
+        double wc = w[c], q0 = wc;
         double Ue = u[c] + u[c + 1], Uw = u[c - sx] + u[c - sx + 1];
         double X = (Ue * (wc + w[c + sx]) - Uw * (w[c - sx] + wc)) * k->rv;
         double Vn = v[c] + v[c + 1], Vs = v[c - sy] + v[c - sy + 1];
         double Y = (Vn * (wc + w[c + sy]) - Vs * (w[c - sy] + wc)) * 0.25 * rdy;
         double Wt = wc + w[c + 1], Wb = w[c - 1] + wc;
         double Z = (Wt * Wt - Wb * Wb) * 0.25 * rdz;
-        double V = k->cw * w[c - sx] + k->ce * w[c + sx] - k->cd * wc + k->cy * (w[c + sy] + w[c - sy]) +
-                   k->cz * (w[c + 1] + w[c - 1]) + k->xw;
-        out[c] = ca * (X + Y + Z) + V;
+        double Lu = k->cw * w[c - sx] + k->ce * w[c + sx] - k->cd * wc + k->cy * (w[c + sy] + w[c - sy]) +
+                    k->cz * (w[c + 1] + w[c - 1]) + k->xw;
+        double h = st->ca * (X + Y + Z) + st->cv * Lu;
+        PREDICT(Hd, US, c, h, Lu, 1);
     }
 }
 
 /* The per-i coefficients of component c at local x index i. */
-static void line_coefs(const fluid_t *f, int c, int i, double cv, coef_t *k)
+static void line_coefs(const fluid_t *f, int c, int i, double adt, coef_t *k)
 {
     const grid_t *g = f->g;
     const fluid_priv_t *q = fluid_priv(f);
@@ -121,42 +149,71 @@ static void line_coefs(const fluid_t *f, int c, int i, double cv, coef_t *k)
         k->afw = af[i - 1];
         k->wa = k->wb = k->afe = 0.0;
     }
-    k->cy = cv * L->cy;
-    k->cz = cv * L->cz;
-    k->cw = cv * L->cw[ig];
-    k->ce = cv * L->ce[ig];
-    k->cd = cv * L->cd[ig] + 2.0 * (k->cy + k->cz);
-    k->xw = cv * ((ig == 0 ? q->xwall[c][0] : 0.0) + (ig == g->n[0] - 1 ? q->xwall[c][1] : 0.0));
+    k->cy = L->cy;
+    k->cz = L->cz;
+    k->cw = L->cw[ig];
+    k->ce = L->ce[ig];
+    k->cd = L->cd[ig] + 2.0 * (k->cy + k->cz);
+    k->xw = (ig == 0 ? q->xwall[c][0] : 0.0) + (ig == g->n[0] - 1 ? q->xwall[c][1] : 0.0);
+    k->ag = adt * (c == 0 ? 1.0 / g->dxc[i] : c == 1 ? 1.0 / g->dy : 1.0 / g->dz);
+    k->af = adt * f->prm.body_force[c];
 }
 
-/* out[c] = ca · ∇·(u⊗u)_c + cv · L u_c on the unknowns (ghosts of u must be
- * valid; cv includes ν). */
-void fluid_rhs(const fluid_t *f, double ca, double cv, double *const out[3])
+/* One sweep over the unknowns of every component: H[c] = ca·N_c + cv·L u_c,
+ * and when US is given the predictor u* written over US[c] (= H_old on
+ * entry).  Ghosts of u must be valid. */
+static void rhs_sweep(const fluid_t *f, const stage_t *st, double adt, double *const H[3], double *const US[3])
 {
     const grid_t *g = f->g;
     const double *u = f->u[0], *v = f->u[1], *w = g->dim == 3 ? f->u[2] : NULL;
     long sx = g->sx, sy = g->sy;
     double rdy = 1.0 / g->dy, rdz = g->dim == 3 ? 1.0 / g->dz : 0.0;
-    int is3d = g->dim == 3;
-    for (int c = 0; c < fluid_ncomp(g); c++) {
-        int iend = fluid_iend(g, c), nj = fluid_nu(g, c, 1), nk = fluid_nu(g, c, 2);
-        double *o = out[c];
-        for (int i = 0; i < iend; i++) {
-            coef_t k;
-            line_coefs(f, c, i, cv, &k);
-            FLUID_FOR_LINES(g, i, nj, nk, c0, len)
-            {
-                if (c == 0) {
-                    if (is3d) u_line(u, v, w, o, c0, len, sx, sy, ca, rdy, rdz, &k, 1);
-                    else u_line(u, v, w, o, c0, len, sx, sy, ca, rdy, rdz, &k, 0);
-                } else if (c == 1) {
-                    if (is3d) v_line(u, v, w, o, c0, len, sx, sy, ca, rdy, rdz, &k, 1);
-                    else v_line(u, v, w, o, c0, len, sx, sy, ca, rdy, rdz, &k, 0);
-                } else
-                    w_line(u, v, w, o, c0, len, sx, sy, ca, rdy, rdz, &k);
-            }
-        }
+    int is3d = g->dim == 3, fused = US != NULL, nc = fluid_ncomp(g);
+    int iend[3], nj[3], nk[3];
+    for (int c = 0; c < nc; c++) {
+        iend[c] = fluid_iend(g, c);
+        nj[c] = fluid_nu(g, c, 1);
+        nk[c] = fluid_nu(g, c, 2);
     }
+    double *nous[3] = {NULL, NULL, NULL};
+    double *const *us = fused ? US : nous;
+    for (int i = 0; i < g->nxl; i++) {
+        coef_t k[3];
+        for (int c = 0; c < nc; c++) line_coefs(f, c, i, adt, &k[c]);
+        int nl = is3d ? g->n[1] : 1;
+        for (int jl = 0; jl < nl; jl++)
+            for (int c = 0; c < nc; c++) {
+                if (i >= iend[c] || (is3d && jl >= nj[c])) continue;
+                long c0 = G_IDX(g, i, jl, 0), len = is3d ? nk[c] : nj[c];
+                if (c == 0) {
+                    if (is3d && fused) u_line(u, v, w, H[0], us[0], c0, len, sx, sy, rdy, rdz, &k[0], st, 1, 1);
+                    else if (is3d) u_line(u, v, w, H[0], us[0], c0, len, sx, sy, rdy, rdz, &k[0], st, 1, 0);
+                    else if (fused) u_line(u, v, w, H[0], us[0], c0, len, sx, sy, rdy, rdz, &k[0], st, 0, 1);
+                    else u_line(u, v, w, H[0], us[0], c0, len, sx, sy, rdy, rdz, &k[0], st, 0, 0);
+                } else if (c == 1) {
+                    if (is3d && fused) v_line(u, v, w, H[1], us[1], c0, len, sx, sy, rdy, rdz, &k[1], st, 1, 1);
+                    else if (is3d) v_line(u, v, w, H[1], us[1], c0, len, sx, sy, rdy, rdz, &k[1], st, 1, 0);
+                    else if (fused) v_line(u, v, w, H[1], us[1], c0, len, sx, sy, rdy, rdz, &k[1], st, 0, 1);
+                    else v_line(u, v, w, H[1], us[1], c0, len, sx, sy, rdy, rdz, &k[1], st, 0, 0);
+                } else {
+                    if (fused) w_line(u, v, w, H[2], us[2], c0, len, sx, sy, rdy, rdz, &k[2], st, 1);
+                    else w_line(u, v, w, H[2], us[2], c0, len, sx, sy, rdy, rdz, &k[2], st, 0);
+                }
+            }
+    }
+}
+
+void fluid_rhs(const fluid_t *f, double ca, double cv, double *const out[3])
+{
+    stage_t st = {.ca = ca, .cv = cv, .p = f->p};
+    rhs_sweep(f, &st, 0.0, out, NULL);
+}
+
+void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
+                       double *const H[3], double *const US[3])
+{
+    stage_t st = {.ca = ca, .cv = cv, .dg = dg, .dz = dz, .ce = ce, .p = f->p};
+    rhs_sweep(f, &st, adt, H, US);
 }
 
 void fluid_advection(const fluid_t *f, double *const out[3]) { fluid_rhs(f, 1.0, 0.0, out); }

@@ -9,8 +9,11 @@ typedef struct {
     poisson_t *pp;         /* VAR_P: projection (L = D·G) */
     poisson_t *pv[3];      /* L of each velocity location: the Crank–Nicolson Helmholtz
                             * solvers when implicit, the operator alone when explicit */
-    double *dudt[3];       /* explicit right-hand side of the current RK stage */
-    double *dudt_old[3];   /* ... of the previous stage (the ζ term) */
+    /* Runge–Kutta storage, rotated with u[c] at every stage (fluid_step):
+     * h[c] holds H of the previous stage (the ζ term) and receives u*;
+     * spare[c] receives H of this stage. */
+    double *h[3];
+    double *spare[3];
     double *work;          /* scratch: the pressure correction φ, the Helmholtz right-hand sides */
     double *halo_buf;      /* send and receive buffers of the combined x halo (2 × 3 planes) */
     /* metric of the local x range, index −1..nxl (stored at +1): face and
@@ -51,6 +54,10 @@ static inline double dmax(double a, double b) { return a > b ? a : b; }
 
 /* advection.c: out = ca·∇·(u⊗u) + cv·L u, one fused sweep */
 void fluid_rhs(const fluid_t *f, double ca, double cv, double *const out[3]);
+/* the same, H = ca·N + cv·L u, with the predictor in the same sweep:
+ * US[c] (H_old on entry) ← u + dg·H + dz·H_old + adt·(f − G p) + ce·L u */
+void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
+                       double *const H[3], double *const US[3]);
 /* viscous.c */
 void fluid_laplacian_add(const fluid_t *f, int c, const double *u, double scale, double *out);
 void fluid_wall_terms_add(const fluid_t *f, int c, double scale, double *out);

@@ -107,49 +107,21 @@ void fluid_project(fluid_t *f)
     fluid_project_stage(f, 1.0, 0, NULL);
 }
 
-/* Predictor of one stage for component c (u^{k−1} → u*). */
-static void predict_component(fluid_t *f, int c, int stage, double dt)
+/* Crank–Nicolson: u[c] holds the explicit part rhs = u* of the predictor;
+ * solve (I − αΔtν/2 L) u* = rhs  ⇔  (L_hom − λ) u* = −λ rhs − wall terms. */
+static void helmholtz_component(fluid_t *f, int c, double adt)
 {
     const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
-    double gam = rk_gamma[stage], zet = rk_zeta[stage], a = gam + zet, adt = a * dt;
-    double *restrict u = f->u[c];
-    const double *restrict h = q->dudt[c], *restrict ho = q->dudt_old[c];
-    double *restrict w = q->work;
-    double fc = f->prm.body_force[c];
-    int impl = f->prm.implicit_viscous;
+    double *restrict u = f->u[c], *restrict w = q->work;
     int iend = fluid_iend(g, c), nj = fluid_nu(g, c, 1), nk = fluid_nu(g, c, 2);
-    if (impl) {
-        /* w = (αΔtν/2) L u^{k−1}, the explicit half of Crank–Nicolson */
-        field_zero(g, w);
-        fluid_laplacian_add(f, c, u, 0.5 * adt * f->prm.nu, w);
-    }
-    long sp = grad_stride(g, c);
-    const double *restrict p = f->p;
-    double dg = dt * gam, dz = dt * zet, af = adt * fc;
-    for (int i = 0; i < iend; i++) {
-        double ag = adt * grad_rdx(g, c, i);
+    double lam = 2.0 / (adt * f->prm.nu);
+    for (int i = 0; i < iend; i++)
         FLUID_FOR_LINES(g, i, nj, nk, c0, len)
-        {
-            if (impl)
-                for (long m = c0; m < c0 + len; m++) u[m] += dg * h[m] + dz * ho[m] + af - ag * (p[m + sp] - p[m]) + w[m];
-            else
-                for (long m = c0; m < c0 + len; m++) u[m] += dg * h[m] + dz * ho[m] + af - ag * (p[m + sp] - p[m]);
-        }
-    }
-    if (impl) {
-        /* (I − αΔtν/2 L) u* = rhs  ⇔  (L_hom − λ) u* = −λ rhs − wall terms */
-        double lam = 2.0 / (adt * f->prm.nu);
-        for (int i = 0; i < iend; i++)
-            for (int j = 0; j < nj; j++)
-                for (int k = 0; k < nk; k++) {
-                    long m = G_IDX(g, i, j, k);
-                    w[m] = -lam * u[m];
-                }
-        fluid_wall_terms_add(f, c, -1.0, w);
-        if (poisson_solve(q->pv[c], lam, w, u) != 0)
-            warn("step %ld: the Helmholtz solve of component %c did not converge\n", f->step, "uvw"[c]);
-    }
+        for (long m = c0; m < c0 + len; m++) w[m] = -lam * u[m];
+    fluid_wall_terms_add(f, c, -1.0, w);
+    if (poisson_solve(q->pv[c], lam, w, u) != 0)
+        warn("step %ld: the Helmholtz solve of component %c did not converge\n", f->step, "uvw"[c]);
 }
 
 void fluid_step(fluid_t *f, double dt)
@@ -161,14 +133,21 @@ void fluid_step(fluid_t *f, double dt)
     for (int s = 0; s < 3; s++) {
         double adt = (rk_gamma[s] + rk_zeta[s]) * dt;
         /* H^k = −∇·(u⊗u) [+ νLu] from u^{k−1} (its ghosts are valid: every
-         * stage ends with them) */
-        fluid_rhs(f, -1.0, f->prm.implicit_viscous ? 0.0 : f->prm.nu, q->dudt);
-        for (int c = 0; c < nc; c++) predict_component(f, c, s, dt);
+         * stage ends with them) into spare, and the predictor
+         * u* = u^{k−1} + Δt(γH^k + ζH^{k−1}) + αΔt(f − G p) [+ αΔtν/2 L u^{k−1}]
+         * over h (which held H^{k−1}), in one sweep; then rotate:
+         * u ← u*, h ← H^k, spare ← u^{k−1} (free). */
+        int impl = f->prm.implicit_viscous;
+        fluid_rhs_predict(f, -1.0, impl ? 0.0 : f->prm.nu, dt * rk_gamma[s], dt * rk_zeta[s], adt,
+                          impl ? 0.5 * adt * f->prm.nu : 0.0, q->spare, q->h);
         for (int c = 0; c < nc; c++) {
-            double *t = q->dudt[c];
-            q->dudt[c] = q->dudt_old[c];
-            q->dudt_old[c] = t;
+            double *old = f->u[c];
+            f->u[c] = q->h[c];
+            q->h[c] = q->spare[c];
+            q->spare[c] = old;
         }
+        if (impl)
+            for (int c = 0; c < nc; c++) helmholtz_component(f, c, adt);
         fluid_apply_bc(f);
         if (f->stage_hook) {
             f->stage_hook(f, s, adt, f->hook_ctx);
