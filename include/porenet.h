@@ -64,6 +64,8 @@ typedef struct {
     int *tet;           /* 4*ntet point indices */
     int *nbr;           /* 4*ntet: tetrahedron across the face opposite vertex k; -1: none (hull edge) */
     double *P;          /* 3*ntet power centres (orthocentres) */
+    double *cond;       /* conditioning of each power-centre solve (|det| relative to the scale³; 0: hyperplane) */
+    int *grp;           /* qhull facet the tetrahedron was split from (Qt: co-spherical set), or -1 */
     double margin;      /* width of the image layer */
     int n_flat;         /* lower facets whose tetrahedron is flat (power centre from the hyperplane) */
 } pn_tri_t;

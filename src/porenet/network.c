@@ -200,6 +200,24 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
                 if (a != b) par[a < b ? b : a] = a < b ? a : b;
             }
         }
+    /* tetrahedra split by qhull from one co-spherical facet */
+    {
+        int ng = 0;
+        for (int i = 0; i < nt; i++) ng = t->grp[i] + 1 > ng ? t->grp[i] + 1 : ng;
+        int *first = malloc((size_t)(ng + 1) * sizeof *first);
+        for (int g = 0; g < ng; g++) first[g] = -1;
+        for (int i = 0; i < nt; i++) {
+            int g = t->grp[i];
+            if (g < 0) continue;
+            if (first[g] < 0) {
+                first[g] = i;
+                continue;
+            }
+            int a = uf_find(par, i), b = uf_find(par, first[g]);
+            if (a != b) par[a < b ? b : a] = a < b ? a : b;
+        }
+        free(first);
+    }
     int *cl = malloc((size_t)nt * sizeof *cl); /* cluster of each tet (its root tet) */
     for (int i = 0; i < nt; i++) cl[i] = uf_find(par, i);
     free(par);
@@ -214,12 +232,22 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
         free(fill);
     }
 
+    /* ---- centre of each cluster: the best-conditioned member's ---- */
+    double *cP = malloc(3 * (size_t)nt * sizeof *cP);
+    for (int c = 0; c < nt; c++) {
+        if (cl[c] != c) continue;
+        int best = c;
+        for (int q = cstart[c]; q < cstart[c + 1]; q++)
+            if (t->cond[clist[q]] > t->cond[best]) best = clist[q];
+        memcpy(cP + 3 * c, t->P + 3 * best, 3 * sizeof(double));
+    }
+
     /* ---- status of each cluster with respect to the walls ---- */
     unsigned char *st = malloc(3 * (size_t)nt); /* per axis, for roots */
     double *cw = malloc((size_t)nt * sizeof *cw);
     for (int c = 0; c < nt; c++) {
         if (cl[c] != c) continue;
-        const double *P = t->P + 3 * c;
+        const double *P = cP + 3 * c;
         double w = 1.0;
         for (int a = 0; a < 3; a++) {
             unsigned char s = ST_IN;
@@ -288,7 +316,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
         pore_of[c] = np++;
     }
     if (np == 0) {
-        free(cl), free(cstart), free(clist), free(st), free(cw), free(vl), free(key), free(pore_of), free(kstore);
+        free(cl), free(cstart), free(clist), free(st), free(cw), free(cP), free(vl), free(key), free(pore_of), free(kstore);
         return fail(err, nerr, "no pore inside the box");
     }
     H.cap = 1;
@@ -365,13 +393,13 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
                     break;
                 }
                 double dx[3];
-                sub3(t->P + 3 * nb, t->P + 3 * c, dx);
+                sub3(cP + 3 * nb, cP + 3 * c, dx);
                 /* count each facet once: from the pore with the smaller index,
                  * or, between a pore and its own periodic copy, along +shift */
                 if (pj < pi) continue;
                 if (pj == pi) {
                     double s[3];
-                    sub3(t->P + 3 * nb, t->P + 3 * proot[pj], s);
+                    sub3(cP + 3 * nb, cP + 3 * proot[pj], s);
                     int pos = 0;
                     for (int a = 0; a < 3; a++)
                         if (fabs(s[a]) > 0.5 * tol_merge) {
@@ -396,8 +424,8 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
                 for (int v = 0; v < 4; v++)
                     if (v != k) tfv[3 * nth + m++] = t->tet[4 * tt + v];
                 memcpy(tdx + 3 * nth, dx, sizeof dx);
-                memcpy(tPi + 3 * nth, t->P + 3 * c, 3 * sizeof(double));
-                memcpy(tPj + 3 * nth, t->P + 3 * nb, 3 * sizeof(double));
+                memcpy(tPi + 3 * nth, cP + 3 * c, 3 * sizeof(double));
+                memcpy(tPj + 3 * nth, cP + 3 * nb, 3 * sizeof(double));
                 twt[nth] = w;
                 tplane[nth] = plane;
                 nth++;
@@ -414,7 +442,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
     free(key);
     free(canon);
     if (status) {
-        free(cl), free(cstart), free(clist), free(st), free(cw), free(pore_of), free(proot);
+        free(cl), free(cstart), free(clist), free(st), free(cw), free(cP), free(pore_of), free(proot);
         free(tp), free(tfv), free(tdx), free(twt), free(tplane), free(tPi), free(tPj);
         return -1;
     }
@@ -435,7 +463,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
     net->tets = malloc((size_t)net->ntets[np] * sizeof(int));
     for (int p = 0; p < np; p++) {
         int c = proot[p];
-        memcpy(net->P + 3 * p, t->P + 3 * c, 3 * sizeof(double));
+        memcpy(net->P + 3 * p, cP + 3 * c, 3 * sizeof(double));
         net->w[p] = cw[c];
         net->face[p] = net->dirichlet[p] = -1;
         for (int a = 0; a < 3; a++) {
@@ -507,9 +535,14 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
             secsum += sec[v];
         }
         double Af = Sa - secsum;
-        if (Af <= 1e-6 * Sa) { /* overlapping spheres cover the facet */
+        if (Af <= 1e-6 * Sa) {
+            /* The sectors cover the facet (a flat triangle whose obtuse-angle
+             * sector overshoots the opposite edge, or overlapping spheres):
+             * keep a sliver of fluid area and scale the sectors down so that
+             * the facet still passes |S| Δp in total (the force balance). */
             net->n_negative_area++;
             Af = 1e-6 * Sa;
+            for (int v = 0; v < 3; v++) sec[v] *= (Sa - Af) / secsum;
         }
         double Vtot = fabs(dot3(S, d)) / 3.0, om[3], vsol = 0, gam = 0;
         for (int v = 0; v < 3; v++) {
@@ -581,6 +614,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
     free(clist);
     free(st);
     free(cw);
+    free(cP);
     free(pore_of);
     free(proot);
     return 0;

@@ -41,6 +41,8 @@ void pn_tri_free(pn_tri_t *t)
     free(t->tet);
     free(t->nbr);
     free(t->P);
+    free(t->cond);
+    free(t->grp);
     memset(t, 0, sizeof *t);
 }
 
@@ -86,6 +88,13 @@ static double orthocentre(const double c[4][3], const double r[4], double P[3])
     }
     for (int a = 0; a < 3; a++) P[a] = c[0][a] + y[a];
     return rel;
+}
+
+static const double **sort_own;
+static int cmp_own(const void *a, const void *b)
+{
+    const double *x = sort_own[*(const int *)a], *y = sort_own[*(const int *)b];
+    return x < y ? -1 : x > y;
 }
 
 static int fail(char *err, size_t nerr, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
@@ -207,6 +216,10 @@ int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double 
     t->tet = malloc(4 * (size_t)nt * sizeof *t->tet);
     t->nbr = malloc(4 * (size_t)nt * sizeof *t->nbr);
     t->P = malloc(3 * (size_t)nt * sizeof *t->P);
+    t->cond = malloc((size_t)nt * sizeof *t->cond);
+    t->grp = malloc((size_t)nt * sizeof *t->grp);
+    /* tetrahedra split from one merged (co-spherical) facet share its normal */
+    const double **own = malloc((size_t)nt * sizeof *own);
     FORALLfacets {
         if (facet->visitid == (unsigned)-1) continue;
         int k = (int)facet->visitid, v = 0;
@@ -233,12 +246,37 @@ int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double 
             for (int a = 0; a < 3; a++) c[v][a] = X[3 * p + a];
             rr[v] = R[p];
         }
-        if (orthocentre(c, rr, P) < 1e-10) {
+        /* A badly shaped tetrahedron (found in the symmetric sets at walls)
+         * loses digits in the 3×3 solve: below 1e-6 the hyperplane (shared by
+         * the whole co-spherical set) is more accurate. */
+        double cnd = orthocentre(c, rr, P);
+        if (cnd < 1e-6) {
             for (int a = 0; a < 3; a++) P[a] = ctr[a] - scale * facet->normal[a] / (2.0 * facet->normal[3]);
             t->n_flat++;
+            cnd = 0;
         }
         memcpy(t->P + 3 * k, P, sizeof P);
+        t->cond[k] = cnd;
+        own[k] = facet->tricoplanar ? facet->normal : NULL;
     }
+    /* number the co-spherical groups: same normal pointer */
+    {
+        int *ord = malloc((size_t)nt * sizeof *ord);
+        for (int k = 0; k < nt; k++) ord[k] = k;
+        for (int k = 0; k < nt; k++) t->grp[k] = -1;
+        /* sort indices by pointer (qsort with a file-scope key array) */
+        sort_own = own;
+        qsort(ord, (size_t)nt, sizeof *ord, cmp_own);
+        int g = -1;
+        for (int m = 0; m < nt; m++) {
+            int k = ord[m];
+            if (!own[k]) continue;
+            if (m == 0 || own[ord[m - 1]] != own[k]) g++;
+            t->grp[k] = g;
+        }
+        free(ord);
+    }
+    free(own);
     qh_freeqhull(qh, !qh_ALL);
     int cl, tl;
     qh_memfreeshort(qh, &cl, &tl);
