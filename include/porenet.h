@@ -168,4 +168,63 @@ void pn_face_forces(const pn_domain_t *dom, const pn_net_t *net, const double *p
 void pn_forces(const pn_domain_t *dom, const pn_tri_t *t, const pn_net_t *net, const double *p, int n, double *f,
                double *fp, double *fv);
 
+/* ---- the model: triangulation + network + solver, as used in a run (model.c) ---- */
+
+typedef struct {
+    pn_domain_t dom;
+    pn_params_t prm;
+    pn_solver_kind_t kind;
+    double pcg_tol;
+    double eps_retri;   /* re-triangulate when Σ_steps max_i |ΔV_i/V_i| exceeds this (thesis 5.13–5.14); 0: every step */
+    double margin;      /* image layer (0: auto) */
+    double rho_f;       /* fluid density (Reynolds number, buoyancy) */
+    int n;
+    pn_tri_t tri;
+    pn_net_t net;
+    pn_solver_t *sol;
+    int built;
+    double *p, *vol, *vol_prev, *dvdt, *x_prev;
+    double *f, *fp, *fv;
+    double eps_acc;     /* accumulated pore strain since the last triangulation */
+    long n_retri, n_steps;
+    /* wall times: last triangulation / network / factorisation, cumulated solve and force times */
+    double t_tri, t_net, t_factor, t_solve, t_force, t_vol;
+    double *snap_time;  /* times of the snapshots written (output.c) */
+    long *snap_counts;  /* points, tetrahedra, throats, spheres of each snapshot */
+    int nsnap;
+    char err[512];
+} pn_model_t;
+
+/* Keys of [porenet] (config.c) and the domain of a case file. */
+void porenet_register_keys(void);
+struct cfg;
+void pn_model_from_config(struct cfg *cfg, pn_model_t *m);
+
+/* Build the network for positions x and radii r (n spheres); 0 or -1 (m->err). */
+int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r);
+/* One coupled step: the spheres moved from the previous call's positions to
+ * x during dt (dt <= 0 or first call: rigid skeleton, no volume change).
+ * Re-triangulates when due, solves, computes m->f.  0 or -1 (m->err). */
+int pn_model_step(pn_model_t *m, int n, const double *x, const double *r, double dt);
+void pn_model_free(pn_model_t *m);
+
+/* Permeability along axis a: imposed-pressure faces on both ends of a
+ * walled axis (κ = μ Q L/(ΔP S)), or a mean gradient on a periodic axis
+ * (κ = −μ ⟨U_a⟩/∂_a p).  NAN when the case has neither. */
+double pn_model_permeability(const pn_model_t *m, int a);
+
+/* Validity of the model (catalano_pfv.md §5.1): pore Reynolds number
+ * ρ_f u d/μ with u = max |q|/A, smallest r / mean r, porosity.  Returns the
+ * number of warnings written into buf (one line each). */
+int pn_model_validity(const pn_model_t *m, const double *r, char *buf, size_t nbuf, double *re, double *size_ratio,
+                      double *porosity);
+
+/* Output (output.c, rank 0, plain HDF5): the tetrahedra of the pores (with
+ * pore pressure), the throats (segments P_i P_j with flux) and the spheres
+ * (fluid force) in DIR/porenet_NNNNN.h5 (NNNNN = m->nsnap), indexed by
+ * DIR/porenet.xmf (XDMF 2, unstructured grids ParaView opens).  The
+ * tetrahedra are those of the pores, the halves of the wall pores outside the
+ * box included (each carries its pore's pressure). */
+void pn_write_snapshot(pn_model_t *m, const double *x, const char *dir, double time);
+
 #endif

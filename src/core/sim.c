@@ -149,6 +149,7 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
 
     /* Parts of the scene, in the order they advance. */
     if (cfg_has_section(cfg, "fluid")) sim_add_fluid(s, cfg);
+    if (cfg_has_section(cfg, "porenet")) sim_add_porenet(s, cfg);
     /* (particles / DEM, immersed boundary coupling, pore network: add here) */
 
     if (s->npart == 0) {
