@@ -118,6 +118,10 @@ pn_solver_t *pn_solver_create(const pn_domain_t *dom, const pn_net_t *net, pn_so
         cholmod_start(&s->cc);
         s->cc_started = 1;
         s->cc.print = 0;
+        /* nested dissection (METIS) ordering: less fill than AMD on these
+         * 3-D mesh-like graphs */
+        s->cc.nmethods = 1;
+        s->cc.method[0].ordering = CHOLMOD_METIS;
         cholmod_triplet *T = cholmod_allocate_triplet((size_t)nu, (size_t)nu, (size_t)(nu + nth), 1, CHOLMOD_REAL, &s->cc);
         int *Ti = T->i, *Tj = T->j;
         double *Tx = T->x;
