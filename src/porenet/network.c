@@ -27,19 +27,11 @@
 #include <string.h>
 
 #include "porenet.h"
+#include "porenet_internal.h"
 #include "util.h"
 
 enum { ST_IN = 0, ST_LO, ST_HI, ST_OUT };
 
-static int fail(char *err, size_t nerr, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-static int fail(char *err, size_t nerr, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, nerr, fmt, ap);
-    va_end(ap);
-    return -1;
-}
 
 void pn_network_free(pn_net_t *n)
 {
@@ -317,7 +309,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
     }
     if (np == 0) {
         free(cl), free(cstart), free(clist), free(st), free(cw), free(cP), free(vl), free(key), free(pore_of), free(kstore);
-        return fail(err, nerr, "no pore inside the box");
+        return pn_fail(err, nerr, "no pore inside the box");
     }
     H.cap = 1;
     while (H.cap < 2 * np) H.cap *= 2;
@@ -350,7 +342,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
             for (int k = 0; k < 4; k++) {
                 int u = t->nbr[4 * tt + k];
                 if (u < 0) {
-                    status = fail(err, nerr,
+                    status = pn_fail(err, nerr,
                                   "pore %d reaches the rim of the triangulated cloud: image margin (%g) too small",
                                   pi, t->margin);
                     break;
@@ -389,7 +381,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
                 }
                 int pj = canon[nb];
                 if (pj < 0) {
-                    status = fail(err, nerr, "pore %d: the periodic copy of a neighbour has no canonical pore", pi);
+                    status = pn_fail(err, nerr, "pore %d: the periodic copy of a neighbour has no canonical pore", pi);
                     break;
                 }
                 double dx[3];

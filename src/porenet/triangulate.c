@@ -30,6 +30,7 @@
 #include <libqhull_r/qhull_ra.h>
 
 #include "porenet.h"
+#include "porenet_internal.h"
 #include "util.h"
 
 void pn_tri_free(pn_tri_t *t)
@@ -97,8 +98,7 @@ static int cmp_own(const void *a, const void *b)
     return x < y ? -1 : x > y;
 }
 
-static int fail(char *err, size_t nerr, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
-static int fail(char *err, size_t nerr, const char *fmt, ...)
+int pn_fail(char *err, size_t nerr, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
@@ -111,19 +111,19 @@ int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double 
                    char *err, size_t nerr)
 {
     memset(t, 0, sizeof *t);
-    if (n < 1) return fail(err, nerr, "no spheres");
+    if (n < 1) return pn_fail(err, nerr, "no spheres");
     double rmax = 0;
     for (int i = 0; i < n; i++) {
         rmax = fmax(rmax, r[i]);
         for (int a = 0; a < 3; a++) {
             double v = x[3 * i + a];
             if (!(v >= dom->lo[a] && v <= dom->hi[a]))
-                return fail(err, nerr, "sphere %d: centre (%g, %g, %g) outside the box", i, x[3 * i], x[3 * i + 1],
+                return pn_fail(err, nerr, "sphere %d: centre (%g, %g, %g) outside the box", i, x[3 * i], x[3 * i + 1],
                             x[3 * i + 2]);
             /* A centre inside its own mirror image would be a hidden point
              * (§1.2): the distance to a wall must exceed r/2. */
             if (!dom->periodic[a] && (v - dom->lo[a] <= 0.5 * r[i] || dom->hi[a] - v <= 0.5 * r[i]))
-                return fail(err, nerr, "sphere %d: centre closer than r/2 to a wall of axis %c (overlap with the wall)",
+                return pn_fail(err, nerr, "sphere %d: centre closer than r/2 to a wall of axis %c (overlap with the wall)",
                             i, 'x' + a);
         }
     }
@@ -131,7 +131,7 @@ int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double 
     t->margin = margin;
     for (int a = 0; a < 3; a++)
         if (margin >= dom->hi[a] - dom->lo[a])
-            return fail(err, nerr, "box length along %c (%g) is not larger than the image margin %g (3 diameters)",
+            return pn_fail(err, nerr, "box length along %c (%g) is not larger than the image margin %g (3 diameters)",
                         'x' + a, dom->hi[a] - dom->lo[a], margin);
 
     /* ---- extended point set ---- */
@@ -199,7 +199,7 @@ int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double 
         int cl, tl;
         qh_memfreeshort(qh, &cl, &tl);
         free(pts);
-        return fail(err, nerr, "qhull failed (exit code %d) on %zu lifted points", code, np);
+        return pn_fail(err, nerr, "qhull failed (exit code %d) on %zu lifted points", code, np);
     }
 
     /* Number the lower facets. */
