@@ -79,7 +79,6 @@ fluid_t *fluid_create(grid_t *g, const fluid_params_t *prm)
                                          : poisson_create_operator(g, (var_loc_t)c);
     }
     f->p = field_alloc(g);
-    q->phi = field_alloc(g);
     q->work = field_alloc(g);
     q->pp = poisson_create(g, VAR_P, &prm->poisson);
 
@@ -108,7 +107,6 @@ void fluid_free(fluid_t *f)
         poisson_free(q->pv[c]);
     }
     free(f->p);
-    free(q->phi);
     free(q->work);
     poisson_free(q->pp);
     free(q->af - 1);

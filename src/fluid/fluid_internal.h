@@ -11,8 +11,7 @@ typedef struct {
                             * solvers when implicit, the operator alone when explicit */
     double *dudt[3];       /* explicit right-hand side of the current RK stage */
     double *dudt_old[3];   /* ... of the previous stage (the ζ term) */
-    double *phi;           /* pressure correction */
-    double *work;          /* scratch */
+    double *work;          /* scratch: the pressure correction φ, the Helmholtz right-hand sides */
     /* metric of the local x range, index −1..nxl (stored at +1): face and
      * centre area factors (r in axisymmetric geometry, 1 otherwise) */
     double *af, *ac;
@@ -38,9 +37,19 @@ static inline int fluid_iend(const grid_t *g, int c)
     return e < g->nxl ? e : g->nxl;
 }
 static inline int fluid_ncomp(const grid_t *g) { return g->dim; }
+/* The unknowns of one component at local x index i as contiguous lines:
+ * (j, k = 0..nk−1) for each j in 3-D, (j = 0..nj−1, k = 0) in 2-D, where the
+ * j stride is 1 (nz = 1, no z ghosts).  Declares c0 (first index) and len. */
+#define FLUID_FOR_LINES(g, i, nj, nk, c0, len)                                          \
+    for (int jl_ = 0, nl_ = (g)->dim == 3 ? (nj) : 1; jl_ < nl_; jl_++)                \
+        for (long c0 = G_IDX(g, i, (g)->dim == 3 ? jl_ : 0, 0), len = (g)->dim == 3 ? (nk) : (nj), once_ = 1; \
+             once_; once_ = 0)
 
-/* advection.c */
-void fluid_advection_add(const fluid_t *f, double scale, double *const out[3]);
+/* max without the NaN rules of fmax (which the compiler cannot inline) */
+static inline double dmax(double a, double b) { return a > b ? a : b; }
+
+/* advection.c: out = ca·∇·(u⊗u) + cv·L u, one fused sweep */
+void fluid_rhs(const fluid_t *f, double ca, double cv, double *const out[3]);
 /* viscous.c */
 void fluid_laplacian_add(const fluid_t *f, int c, const double *u, double scale, double *out);
 void fluid_wall_terms_add(const fluid_t *f, int c, double scale, double *out);
@@ -50,9 +59,12 @@ void fluid_fill_ghosts_component(const fluid_t *f, int c, double *u);
 void fluid_fill_pressure_ghosts(const fluid_t *f, double *p);
 /* timestep.c: max over cells of Σ_d |u_d|/Δ_d (|u_d| the larger of the two faces) */
 double fluid_convective_rate(const fluid_t *f);
-/* diagnostics.c: ke, div_max, cfl of f->diag from the current field */
-void fluid_update_diagnostics(fluid_t *f);
+/* diagnostics.c: ke, div_max, cfl of f->diag from the current field (stats:
+ * Σ V u² and max |u| of this rank if already known, else NULL);
+ * div = scale · D u at the cells */
+void fluid_divergence_scaled(const fluid_t *f, double scale, double *div);
+void fluid_update_diagnostics(fluid_t *f, const double *stats);
 /* step.c */
-void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure);
+void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats);
 
 #endif
