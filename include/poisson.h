@@ -68,6 +68,11 @@ struct poisson {
     double cy, cz;        /* 1/dy², 1/dz² (cz = 0 in 2-D) */
     const poisson_backend_t *backend;
     void *impl;
+    /* set by a back-end's create() when its solve() handles a singular
+     * problem (λ = 0, no Dirichlet face) itself: it removes the weighted mean
+     * of b and returns x of zero weighted mean, so poisson_solve need not
+     * copy b (otherwise poisson_solve does it around the back-end) */
+    int backend_handles_singular;
     /* statistics of the last solve */
     double last_residual; /* relative residual ||b − A x|| / ||b|| (measured) */
     int last_iterations;  /* V-cycles (multigrid) or 1 (direct) */

@@ -1,7 +1,7 @@
 /* fft.c — direct solver of (L − λI) x = b by eigenfunction expansion:
- * FFTW real-to-real transforms in the two uniform directions y and z, a
+ * real Fourier-type transforms in the two uniform directions y and z, a
  * tridiagonal solve in x for every (y, z) mode (Schumann & Sweet 1988; the
- * layout follows CaNS, Costa 2018).
+ * slab layout follows CaNS, Costa 2018).
  *
  * The operator is the one of poisson.c: L = L_x + cy δ²_y + cz δ²_z with the
  * homogeneous BCs of the location folded in.  Along y (and z) the BC pair
@@ -9,18 +9,18 @@
  * of the 3-point stencil with those ghosts (h = spacing, n = cells, the
  * transform has m unknowns):
  *
- *   pair (low, high)               kind fwd/inv          eigenvalue × h²        norm
- *   periodic                       R2HC / HC2R            −4 sin²(π k / n)       n
- *   Neumann, Neumann               REDFT10 / REDFT01      −4 sin²(π k / 2n)      2n
- *   Dir.-ghost, Dir.-ghost         RODFT10 / RODFT01      −4 sin²(π(k+1) / 2n)   2n
- *   Dir.-face, Dir.-face (m = n−1) RODFT00 / RODFT00      −4 sin²(π(k+1) / 2n)   2n
- *   Neumann, Dir.-ghost            REDFT11 / REDFT11      −4 sin²(π(k+½) / 2n)   2n
- *   Dir.-ghost, Neumann            RODFT11 / RODFT11      −4 sin²(π(k+½) / 2n)   2n
+ *   pair (low, high)               FFTW kind fwd/inv     eigenvalue × h²        norm
+ *   periodic                       R2HC / HC2R (or DFT)  −4 sin²(π k / n)       n
+ *   Neumann, Neumann               REDFT10 / REDFT01     −4 sin²(π k / 2n)      2n
+ *   Dir.-ghost, Dir.-ghost         RODFT10 / RODFT01     −4 sin²(π(k+1) / 2n)   2n
+ *   Dir.-face, Dir.-face (m = n−1) RODFT00 / RODFT00     −4 sin²(π(k+1) / 2n)   2n
+ *   Neumann, Dir.-ghost            REDFT11 / REDFT11     −4 sin²(π(k+½) / 2n)   2n
+ *   Dir.-ghost, Neumann            RODFT11 / RODFT11     −4 sin²(π(k+½) / 2n)   2n
  *
- * (k = 0..m−1 is the index of the transformed array; in halfcomplex order
- * index k and n−k hold the real and imaginary parts of wavenumber k, which
- * share the eigenvalue since sin²(πk/n) = sin²(π(n−k)/n).)  "norm" is the
- * factor FFTW's unnormalised forward+inverse pair multiplies the data by.
+ * (k = 0..m−1 is the transform index; for a periodic direction the real and
+ * imaginary parts of wavenumber k share the eigenvalue, and sin²(πk/n) =
+ * sin²(π(n−k)/n).)  "norm" is the factor FFTW's unnormalised forward+inverse
+ * pair multiplies the data by.
  *
  * Each mode then satisfies the tridiagonal system along x
  *   cw_i X_{i−1} + (−cd_i − λ + e_y + e_z) X_i + ce_i X_{i+1} = B_i,
@@ -28,21 +28,34 @@
  * periodic).  The loops run over i outside and over a block of modes inside
  * so that the inner loop is contiguous and vectorises; the block's data and
  * scratch stay in cache.  The singular mode (λ = 0, every face periodic or
- * Neumann, e_y = e_z = 0) is solved with its last unknown pinned to 0: its
- * last equation is the weighted sum of the others (poisson_solve removed the
- * weighted mean of b) and poisson_solve re-centres x afterwards.
+ * Neumann, e_y = e_z = 0) is solved with its last unknown pinned (see
+ * solve_zero_mode).
  *
- * MPI: the field is split in x slabs.  The 2-D transforms are local to each x
- * plane; their output is written directly in the order [y mode][i][z mode],
- * so each rank's block of y modes is contiguous and one MPI_Alltoallv gives
- * every rank all x planes of its y modes (no packing); the tridiagonal solves
- * run there, a second Alltoallv brings the modes back, and the inverse
- * transforms write x.  Uneven splits of the y modes are allowed.  With one
- * rank the transforms write [i][y mode][z mode] and nothing is exchanged.
+ * Fast path (3-D, each of y and z periodic or Neumann–Neumann with an even
+ * cell count — the pressure of every box, channel or duct): FFTW's real
+ * cosine transforms are several times slower than its complex codelets, so
+ * the cosine transforms are computed from one 2-D real DFT (r2c) of the data
+ * reordered as v(n) = x(2n), v(N−1−n) = x(2n+1) (Makhoul 1980): with
+ * V = DFT(v) and W = e^{−iπ/2N}, DCT-II_k(x) = 2 Re(W^k V_k).  In 2-D
+ * (y, z), pairing row k1 with N1−k1 (and using V(k1, −k2) = conj V(−k1, k2))
+ * gives every output of a pair of rows from two complex numbers, in one
+ * pass over the data (fast_butterfly); its exact inverse runs before the
+ * inverse DFT (c2r).  The z modes are then stored as slot 2k ↔ mode k, slot
+ * 2k+1 ↔ mode N−k (slot 1 holds 0, slot N+1 repeats mode N/2).  Other
+ * boundary pairs, odd sizes and 2-D grids use FFTW's r2r kinds directly
+ * (batched 1-D plans: faster than rank-2 r2r plans, measured).
  *
- * Plans are made once, with FFTW_ESTIMATE by default so that the same input
- * gives bit-identical results run after run (FFTW_MEASURE may choose a
- * different algorithm each run).
+ * MPI: the field is split in x slabs.  The transforms are local to each x
+ * plane; their output is written in the order [y row][i][z slot], so each
+ * rank's block of y rows is contiguous and one MPI_Alltoallv gives every
+ * rank all x planes of its rows (no packing); the tridiagonal solves run
+ * there, a second Alltoallv brings the modes back, and the inverse
+ * transforms write x.  Uneven splits of the rows are allowed.  With one rank
+ * the transforms write [i][y row][z slot] and nothing is exchanged.
+ *
+ * Plans are made once, with FFTW_ESTIMATE so that the same input gives
+ * bit-identical results run after run (FFTW_MEASURE may choose a different
+ * algorithm each run).
  */
 #include <fftw3.h>
 #include <math.h>
@@ -58,10 +71,26 @@
 
 typedef struct {
     int m;                     /* transform length (unknowns) */
-    fftw_r2r_kind fwd, inv;
-    double norm;               /* forward+inverse scale factor */
-    double *eig;               /* eigenvalues of cy δ² (≤ 0), m of them */
+    int periodic, neumann;     /* the BC pair is periodic / Neumann–Neumann */
+    fftw_r2r_kind fwd, inv;    /* real kinds (periodic: R2HC/HC2R) */
+    double norm;               /* forward+inverse scale factor of the r2r kinds */
+    double *eig;               /* eigenvalues of c δ² (≤ 0) by transform index, m of them */
 } tf_dir_t;
+
+/* One batched transform of the pipeline (an FFTW guru plan). */
+typedef enum { TK_R2R, TK_R2C, TK_C2R, TK_C2C } tkind_t;
+typedef enum { SIDE_FIELD, SIDE_WORK, SIDE_AUX } side_t;
+typedef struct {
+    tkind_t kind;
+    int sign;                  /* TK_C2C: FFTW_FORWARD or FFTW_BACKWARD */
+    fftw_r2r_kind rk;          /* TK_R2R (rank 1) */
+    int rank;
+    fftw_iodim dims[2];        /* transformed dimensions (strides in units of each side's type) */
+    int nhow;
+    fftw_iodim how[2];         /* loops: x planes, then rows or columns */
+    side_t in, out;
+    fftw_plan plan[2];         /* per alignment class of the field pointer */
+} step_t;
 
 typedef struct {
     poisson_t *p;
@@ -70,10 +99,22 @@ typedef struct {
     int nxu;                   /* local unknown x planes */
     int periodic_x;
     tf_dir_t dy, dz;
-    double scale;              /* 1 / (norm_y norm_z) */
+    double scale;              /* 1 / (forward+inverse factor) */
     unsigned plan_flags;
 
-    /* decomposition of the y modes among ranks (P > 1) */
+    /* transformed data of one x plane: TR rows (y modes) of TC doubles (z
+     * modes; re/im interleaved when z, or y in 2-D, is periodic); in the
+     * work array a row starts every RS doubles and a plane every PS */
+    int TR, TC;
+    long RS, PS;
+    step_t fwd[2], inv[2];     /* forward: [0] then [1]; inverse: [0] then [1] */
+    int nsteps;
+    /* fast path: 2-D r2c with Makhoul reordering of the Neumann directions */
+    int fast, ynn, znn;
+    double *aux;               /* reordered copy of the data (fast path with a Neumann direction) */
+    double *wy, *wz;           /* twiddles e^{−iπk/2N} (re, im) */
+
+    /* decomposition of the rows among ranks (P > 1) */
     int P, me;
     int *j0, *nyl, *nxu_r, *scount, *sdispl, *rcount, *rdispl;
     double *work;              /* transformed data in the slab layout */
@@ -85,16 +126,11 @@ typedef struct {
     long *toff, *trs;
     int trows, tcols;
     double *erow, *ecol;
-    int owns_zero_mode;        /* (row 0, col 0) is the mode e_y = e_z = 0 of this rank */
+    int nzero, zcol[4];        /* columns of row 0 with eigenvalue 0 (singular modes) */
+    double *wx;                /* compatibility weights in x (singular problems) */
 
     double *cp, *zs, *gam;     /* scratch of one block */
-    double *zero_rhs;          /* the singular mode's right-hand side */
-
-    /* transforms: dims and loop for the field side (strides of the grid) and
-     * the work side; plans per alignment class of the field pointer */
-    int rank;
-    fftw_iodim fdims[2], fhow, wdims[2], whow;
-    fftw_plan fwd[2], inv[2];
+    double *zero_sol;          /* solutions of the singular modes (nzero × nx) */
 } fft_t;
 
 /* Transform kind, length and eigenvalues of one uniform direction. */
@@ -104,11 +140,13 @@ static void tf_setup(tf_dir_t *t, ebc_t lo, ebc_t hi, int ncell, double c)
     t->m = ncell;
     double shift = 0.0, den = 2.0 * n; /* eigenvalue −4c sin²(π(k+shift)/den) */
     if (lo == EBC_PERIODIC && hi == EBC_PERIODIC) {
+        t->periodic = 1;
         t->fwd = FFTW_R2HC;
         t->inv = FFTW_HC2R;
         t->norm = n;
         den = n;
     } else if (lo == EBC_NEUMANN && hi == EBC_NEUMANN) {
+        t->neumann = 1;
         t->fwd = FFTW_REDFT10;
         t->inv = FFTW_REDFT01;
         t->norm = 2.0 * n;
@@ -139,37 +177,295 @@ static void tf_setup(tf_dir_t *t, ebc_t lo, ebc_t hi, int ncell, double c)
     }
 }
 
-static fftw_plan make_plan(const fft_t *t, int forward, double *in, double *out)
+static fftw_iodim iod(int n, long is, long os)
 {
-    fftw_r2r_kind kind[2] = {forward ? t->dy.fwd : t->dy.inv, forward ? t->dz.fwd : t->dz.inv};
-    const fftw_iodim *di = forward ? t->fdims : t->wdims, *hi = forward ? &t->fhow : &t->whow;
-    const fftw_iodim *dout = forward ? t->wdims : t->fdims, *hout = forward ? &t->whow : &t->fhow;
-    fftw_iodim dims[2], how;
-    for (int d = 0; d < t->rank; d++) dims[d] = (fftw_iodim){di[d].n, di[d].is, dout[d].os};
-    how = (fftw_iodim){hi->n, hi->is, hout->os};
-    unsigned flags = t->plan_flags | (forward ? FFTW_PRESERVE_INPUT : FFTW_DESTROY_INPUT);
-    fftw_plan pl = fftw_plan_guru_r2r(t->rank, dims, 1, &how, in, out, kind, flags);
-    if (!pl) die("poisson fft: FFTW could not plan the %s transform", forward ? "forward" : "inverse");
-    return pl;
+    if (labs(is) > 2147483647L || labs(os) > 2147483647L) die("poisson fft: stride exceeds the FFTW int range");
+    return (fftw_iodim){n, (int)is, (int)os};
 }
 
-/* The plan for a field pointer of the alignment class of `f` (fields from
- * field_alloc all share one class; another class gets its own plan). */
-static fftw_plan plan_for(fft_t *t, int forward, const double *f)
+static step_t step_make(tkind_t kind, fftw_r2r_kind rk, int sign, side_t in, side_t out, int rank, fftw_iodim d0,
+                        fftw_iodim d1, int nhow, fftw_iodim h0, fftw_iodim h1)
 {
-    int a = fftw_alignment_of((double *)f) != 0;
-    fftw_plan *slot = forward ? &t->fwd[a] : &t->inv[a];
-    if (!*slot) {
-        /* plan on scratch arrays of the same alignment (a measuring planner
-         * overwrites its arrays) */
-        const grid_t *g = t->p->g;
-        double *tmp = xcalloc((size_t)g->nalloc + 1, sizeof(double));
-        double *fi = tmp + G_IDX(g, 0, 0, 0);
-        if ((fftw_alignment_of(fi) != 0) != a) fi++;
-        *slot = forward ? make_plan(t, 1, fi, t->work) : make_plan(t, 0, t->work, fi);
-        free(tmp);
+    step_t s;
+    memset(&s, 0, sizeof s);
+    s.kind = kind;
+    s.rk = rk;
+    s.sign = sign;
+    s.in = in;
+    s.out = out;
+    s.rank = rank;
+    s.dims[0] = d0;
+    s.dims[1] = d1;
+    s.nhow = nhow;
+    s.how[0] = h0;
+    s.how[1] = h1;
+    return s;
+}
+
+/* Plan step s for field pointers of alignment class a, on scratch arrays for
+ * the field side (a measuring planner overwrites its arrays). */
+static void step_plan(fft_t *t, step_t *s, int a)
+{
+    const grid_t *g = t->p->g;
+    double *tmp = NULL, *f = NULL;
+    if (s->in == SIDE_FIELD || s->out == SIDE_FIELD) {
+        tmp = xcalloc((size_t)g->nalloc + 2, sizeof(double));
+        f = tmp + G_IDX(g, 0, 0, 0);
+        if ((fftw_alignment_of(f) != 0) != a) f++;
     }
-    return *slot;
+    double *side[3] = {f, t->work, t->aux};
+    double *in = side[s->in], *out = side[s->out];
+    unsigned flags = t->plan_flags | (s->in == SIDE_FIELD ? FFTW_PRESERVE_INPUT : FFTW_DESTROY_INPUT);
+    fftw_plan pl = NULL;
+    switch (s->kind) {
+    case TK_R2R: pl = fftw_plan_guru_r2r(s->rank, s->dims, s->nhow, s->how, in, out, &s->rk, flags); break;
+    case TK_R2C:
+        pl = fftw_plan_guru_dft_r2c(s->rank, s->dims, s->nhow, s->how, in, (fftw_complex *)out, flags);
+        break;
+    case TK_C2R:
+        pl = fftw_plan_guru_dft_c2r(s->rank, s->dims, s->nhow, s->how, (fftw_complex *)in, out, flags);
+        break;
+    case TK_C2C:
+        pl = fftw_plan_guru_dft(s->rank, s->dims, s->nhow, s->how, (fftw_complex *)in, (fftw_complex *)out,
+                                s->sign, flags);
+        break;
+    }
+    if (!pl) die("poisson fft: FFTW could not plan a transform");
+    s->plan[a] = pl;
+    free(tmp);
+}
+
+/* Run step s; f is the field (pointer to its first interior unknown) when a
+ * side of the step is the field. */
+static void step_run(fft_t *t, step_t *s, double *f)
+{
+    int a = (s->in == SIDE_FIELD || s->out == SIDE_FIELD) ? fftw_alignment_of(f) != 0 : 0;
+    if (!s->plan[a]) step_plan(t, s, a);
+    double *side[3] = {f, t->work, t->aux};
+    double *in = side[s->in], *out = side[s->out];
+    fftw_plan pl = s->plan[a];
+    switch (s->kind) {
+    case TK_R2R: fftw_execute_r2r(pl, in, out); break;
+    case TK_R2C: fftw_execute_dft_r2c(pl, in, (fftw_complex *)out); break;
+    case TK_C2R: fftw_execute_dft_c2r(pl, (fftw_complex *)in, out); break;
+    case TK_C2C: fftw_execute_dft(pl, (fftw_complex *)in, (fftw_complex *)out); break;
+    }
+}
+
+/* The transform pipeline.
+ * Fast path: one 2-D r2c over (y, z) per x plane (from the field, or from
+ * the reordered copy aux when a direction is Neumann), c2r back.
+ * General 3-D: z first (field → work; r2c when z is periodic, so its output
+ * is complex and the y step is a complex DFT if y is periodic too, else the
+ * r2r kind of z), then y in place (r2r kind of y, on every double).  2-D: y
+ * only (field → work).  The inverse runs the inverse steps in reverse order. */
+static void setup_steps(fft_t *t)
+{
+    const grid_t *g = t->p->g;
+    long sx = g->sx, sy = g->sy, RS = t->RS, PS = t->PS;
+    int nxu = t->nxu, ny = t->ny, nz = t->nz, TC = t->TC;
+    fftw_iodim none = {0, 0, 0};
+    if (t->fast) {
+        t->nsteps = 1;
+        int reorder = t->ynn || t->znn;
+        side_t src = reorder ? SIDE_AUX : SIDE_FIELD;
+        long isy = reorder ? nz : sy, isx = reorder ? (long)ny * nz : sx;
+        t->fwd[0] = step_make(TK_R2C, 0, 0, src, SIDE_WORK, 2, iod(ny, isy, RS / 2), iod(nz, 1, 1), 1,
+                              iod(nxu, isx, PS / 2), none);
+        t->inv[0] = step_make(TK_C2R, 0, 0, SIDE_WORK, src, 2, iod(ny, RS / 2, isy), iod(nz, 1, 1), 1,
+                              iod(nxu, PS / 2, isx), none);
+    } else if (t->dim3) {
+        t->nsteps = 2;
+        if (t->dz.periodic) {
+            t->fwd[0] = step_make(TK_R2C, 0, 0, SIDE_FIELD, SIDE_WORK, 1, iod(nz, 1, 1), none, 2,
+                                  iod(nxu, sx, PS / 2), iod(ny, sy, RS / 2));
+            t->inv[1] = step_make(TK_C2R, 0, 0, SIDE_WORK, SIDE_FIELD, 1, iod(nz, 1, 1), none, 2,
+                                  iod(nxu, PS / 2, sx), iod(ny, RS / 2, sy));
+        } else {
+            t->fwd[0] = step_make(TK_R2R, t->dz.fwd, 0, SIDE_FIELD, SIDE_WORK, 1, iod(nz, 1, 1), none, 2,
+                                  iod(nxu, sx, PS), iod(ny, sy, RS));
+            t->inv[1] = step_make(TK_R2R, t->dz.inv, 0, SIDE_WORK, SIDE_FIELD, 1, iod(nz, 1, 1), none, 2,
+                                  iod(nxu, PS, sx), iod(ny, RS, sy));
+        }
+        if (t->dy.periodic && t->dz.periodic) {
+            fftw_iodim d = iod(ny, RS / 2, RS / 2), h0 = iod(nxu, PS / 2, PS / 2), h1 = iod(TC / 2, 1, 1);
+            t->fwd[1] = step_make(TK_C2C, 0, FFTW_FORWARD, SIDE_WORK, SIDE_WORK, 1, d, none, 2, h0, h1);
+            t->inv[0] = step_make(TK_C2C, 0, FFTW_BACKWARD, SIDE_WORK, SIDE_WORK, 1, d, none, 2, h0, h1);
+        } else {
+            fftw_iodim d = iod(ny, RS, RS), h0 = iod(nxu, PS, PS), h1 = iod(TC, 1, 1);
+            t->fwd[1] = step_make(TK_R2R, t->dy.fwd, 0, SIDE_WORK, SIDE_WORK, 1, d, none, 2, h0, h1);
+            t->inv[0] = step_make(TK_R2R, t->dy.inv, 0, SIDE_WORK, SIDE_WORK, 1, d, none, 2, h0, h1);
+        }
+    } else {
+        t->nsteps = 1;
+        if (t->dy.periodic) {
+            t->fwd[0] = step_make(TK_R2C, 0, 0, SIDE_FIELD, SIDE_WORK, 1, iod(ny, sy, RS / 2), none, 1,
+                                  iod(nxu, sx, PS / 2), none);
+            t->inv[0] = step_make(TK_C2R, 0, 0, SIDE_WORK, SIDE_FIELD, 1, iod(ny, RS / 2, sy), none, 1,
+                                  iod(nxu, PS / 2, sx), none);
+        } else {
+            t->fwd[0] = step_make(TK_R2R, t->dy.fwd, 0, SIDE_FIELD, SIDE_WORK, 1, iod(ny, sy, RS), none, 1,
+                                  iod(nxu, sx, PS), none);
+            t->inv[0] = step_make(TK_R2R, t->dy.inv, 0, SIDE_WORK, SIDE_FIELD, 1, iod(ny, RS, sy), none, 1,
+                                  iod(nxu, PS, sx), none);
+        }
+    }
+}
+
+/* Makhoul reordering of the Neumann directions: aux[i][n1][n2] =
+ * f[i][p_y(n1)][p_z(n2)] with p(n) = 2n for n < N/2, p(N−1−n) = 2n+1
+ * (identity for a periodic direction); inverse = 1 scatters back. */
+static void reorder(fft_t *t, double *f, int inverse)
+{
+    const grid_t *g = t->p->g;
+    int ny = t->ny, nz = t->nz, hz = nz / 2;
+    for (int i = 0; i < t->nxu; i++)
+        for (int n1 = 0; n1 < ny; n1++) {
+            int j = !t->ynn ? n1 : n1 < ny / 2 ? 2 * n1 : 2 * (ny - 1 - n1) + 1;
+            double *restrict fr = f + G_IDX(g, i, j, 0) - G_IDX(g, 0, 0, 0);
+            double *restrict ar = t->aux + ((long)i * ny + n1) * nz;
+            if (!t->znn) {
+                if (inverse)
+                    memcpy(fr, ar, (size_t)nz * sizeof(double));
+                else
+                    memcpy(ar, fr, (size_t)nz * sizeof(double));
+            } else if (inverse) {
+                for (int m = 0; m < hz; m++) {
+                    fr[2 * m] = ar[m];
+                    fr[2 * m + 1] = ar[nz - 1 - m];
+                }
+            } else {
+                for (int m = 0; m < hz; m++) {
+                    ar[m] = fr[2 * m];
+                    ar[nz - 1 - m] = fr[2 * m + 1];
+                }
+            }
+        }
+}
+
+/* The pass that turns the 2-D DFT V of the reordered data into the cosine
+ * (Neumann direction) / Fourier (periodic direction) coefficients, and its
+ * exact inverse.  For rows k1 and k1' = N1−k1 (mod N1) and z index k2:
+ * P = V(k1, k2), Q = V(k1', k2), β = W1^{k1}, α = W2^{k2} (W = e^{−iπ/2N}).
+ *  both Neumann: a = αP, b = conj(αQ), s = β(a+b), d = β(a−b):
+ *      Y(k1,k2) = 2Re s, Y(k1,N2−k2) = −2Im d, Y(k1',k2) = −2Im s, Y(k1',N2−k2) = −2Re d
+ *  z Neumann, y periodic: T1 = a+b, T2 = i(a−b) are the y-DFT at k1 of the
+ *      z-cosine coefficients k2 and N2−k2: row k1 keeps their real parts, row
+ *      k1' their imaginary parts (same eigenvalue e_y(k1)).
+ *  y Neumann, z periodic: a = βP, b = conj(β)Q, row k1 ← a+b, row k1' ← i(a−b)
+ *      (complex, the y-cosine coefficients k1 and k1').
+ * A row with k1' = k1 (k1 = 0 or N1/2) keeps its own outputs only; the
+ * formulas follow from DCT_k = W^k V_k + W^{−k} V_{N−k} applied in each
+ * direction and V(−k1, −k2) = conj V(k1, k2) for real data. */
+static void fast_butterfly(fft_t *t, int inverse)
+{
+    int N1 = t->ny, H2 = t->nz / 2;
+    const double *wy = t->wy, *wz = t->wz;
+    for (int i = 0; i < t->nxu; i++)
+        for (int k1 = 0; k1 <= N1 / 2; k1++) {
+            int k1p = k1 ? N1 - k1 : 0, self = k1p == k1;
+            double *restrict p = t->work + i * t->PS + k1 * t->RS;
+            double *restrict q = t->work + i * t->PS + k1p * t->RS;
+            if (self) q = p;
+            const double br = wy[2 * k1], bi = wy[2 * k1 + 1];
+            if (t->ynn && t->znn) {
+                if (!inverse)
+                    for (int k = 0; k <= H2; k++) {
+                        double ar = wz[2 * k], ai = wz[2 * k + 1];
+                        double Pr = p[2 * k], Pi = p[2 * k + 1], Qr = q[2 * k], Qi = q[2 * k + 1];
+                        double a_r = ar * Pr - ai * Pi, a_i = ar * Pi + ai * Pr;
+                        double b_r = ar * Qr - ai * Qi, b_i = -(ar * Qi + ai * Qr);
+                        double Sr = a_r + b_r, Si = a_i + b_i, Dr = a_r - b_r, Di = a_i - b_i;
+                        double sr = br * Sr - bi * Si, si = br * Si + bi * Sr;
+                        double dr = br * Dr - bi * Di, di = br * Di + bi * Dr;
+                        p[2 * k] = 2.0 * sr;
+                        p[2 * k + 1] = -2.0 * di;
+                        if (!self) {
+                            q[2 * k] = -2.0 * si;
+                            q[2 * k + 1] = -2.0 * dr;
+                        }
+                    }
+                else
+                    for (int k = 0; k <= H2; k++) {
+                        double ar = wz[2 * k], ai = wz[2 * k + 1];
+                        double Y1 = p[2 * k], Y2 = p[2 * k + 1], Sr, Si, Dr, Di;
+                        if (!self) {
+                            double Y3 = q[2 * k], Y4 = q[2 * k + 1];
+                            double sr = 0.5 * Y1, si = -0.5 * Y3, dr = -0.5 * Y4, di = -0.5 * Y2;
+                            Sr = br * sr + bi * si;
+                            Si = br * si - bi * sr;
+                            Dr = br * dr + bi * di;
+                            Di = br * di - bi * dr;
+                        } else {
+                            double r = 0.5 / br;
+                            Sr = Y1 * r;
+                            Si = 0.0;
+                            Dr = 0.0;
+                            Di = -Y2 * r;
+                        }
+                        double a_r = 0.5 * (Sr + Dr), a_i = 0.5 * (Si + Di);
+                        double b_r = 0.5 * (Sr - Dr), b_i = 0.5 * (Si - Di);
+                        p[2 * k] = ar * a_r + ai * a_i;
+                        p[2 * k + 1] = ar * a_i - ai * a_r;
+                        if (!self) {
+                            q[2 * k] = ar * b_r - ai * b_i;
+                            q[2 * k + 1] = -(ar * b_i + ai * b_r);
+                        }
+                    }
+            } else if (t->znn) {
+                if (!inverse)
+                    for (int k = 0; k <= H2; k++) {
+                        double ar = wz[2 * k], ai = wz[2 * k + 1];
+                        double Pr = p[2 * k], Pi = p[2 * k + 1], Qr = q[2 * k], Qi = q[2 * k + 1];
+                        double a_r = ar * Pr - ai * Pi, a_i = ar * Pi + ai * Pr;
+                        double b_r = ar * Qr - ai * Qi, b_i = -(ar * Qi + ai * Qr);
+                        p[2 * k] = a_r + b_r;       /* Re T1 */
+                        p[2 * k + 1] = b_i - a_i;   /* Re T2 */
+                        if (!self) {
+                            q[2 * k] = a_i + b_i;   /* Im T1 */
+                            q[2 * k + 1] = a_r - b_r; /* Im T2 */
+                        }
+                    }
+                else
+                    for (int k = 0; k <= H2; k++) {
+                        double ar = wz[2 * k], ai = wz[2 * k + 1];
+                        double T1r = p[2 * k], T2r = p[2 * k + 1];
+                        double T1i = self ? 0.0 : q[2 * k], T2i = self ? 0.0 : q[2 * k + 1];
+                        double a_r = 0.5 * (T1r + T2i), a_i = 0.5 * (T1i - T2r);
+                        double b_r = 0.5 * (T1r - T2i), b_i = 0.5 * (T1i + T2r);
+                        p[2 * k] = ar * a_r + ai * a_i;
+                        p[2 * k + 1] = ar * a_i - ai * a_r;
+                        if (!self) {
+                            q[2 * k] = ar * b_r - ai * b_i;
+                            q[2 * k + 1] = -(ar * b_i + ai * b_r);
+                        }
+                    }
+            } else {
+                if (self) {
+                    double f = inverse ? 0.5 / br : 2.0 * br;
+                    for (int k = 0; k < 2 * H2 + 2; k++) p[k] *= f;
+                } else if (!inverse)
+                    for (int k = 0; k <= H2; k++) {
+                        double Pr = p[2 * k], Pi = p[2 * k + 1], Qr = q[2 * k], Qi = q[2 * k + 1];
+                        double a_r = br * Pr - bi * Pi, a_i = br * Pi + bi * Pr;
+                        double b_r = br * Qr + bi * Qi, b_i = br * Qi - bi * Qr;
+                        p[2 * k] = a_r + b_r;
+                        p[2 * k + 1] = a_i + b_i;
+                        q[2 * k] = b_i - a_i;
+                        q[2 * k + 1] = a_r - b_r;
+                    }
+                else
+                    for (int k = 0; k <= H2; k++) {
+                        double U1r = p[2 * k], U1i = p[2 * k + 1], U2r = q[2 * k], U2i = q[2 * k + 1];
+                        double a_r = 0.5 * (U1r + U2i), a_i = 0.5 * (U1i - U2r);
+                        double b_r = 0.5 * (U1r - U2i), b_i = 0.5 * (U1i + U2r);
+                        p[2 * k] = br * a_r + bi * a_i;
+                        p[2 * k + 1] = br * a_i - bi * a_r;
+                        q[2 * k] = br * b_r - bi * b_i;
+                        q[2 * k + 1] = br * b_i + bi * b_r;
+                    }
+            }
+        }
 }
 
 static void *fft_create(poisson_t *p)
@@ -182,6 +478,9 @@ static void *fft_create(poisson_t *p)
     t->ny = p->nu[1];
     t->nz = p->nu[2];
     t->periodic_x = p->ebc[0][0] == EBC_PERIODIC;
+    /* the singular modes are projected and re-centred here (solve_zero_mode),
+     * so poisson_solve need not copy b to remove its mean */
+    p->backend_handles_singular = 1;
     t->nxu = t->nx - g->ix0;
     if (t->nxu > g->nxl) t->nxu = g->nxl;
     if (t->nxu < 0) t->nxu = 0;
@@ -192,41 +491,77 @@ static void *fft_create(poisson_t *p)
         t->dz.m = 1;
         t->dz.norm = 1.0;
         t->dz.eig = xcalloc(1, sizeof(double));
-        t->dz.fwd = t->dz.inv = FFTW_R2HC; /* unused */
     }
     if (t->dy.m != t->ny || t->dz.m != t->nz) die("poisson fft: unknown counts disagree with the transforms");
-    t->scale = 1.0 / (t->dy.norm * t->dz.norm);
     t->plan_flags = FFTW_ESTIMATE;
     int nx = t->nx, ny = t->ny, nz = t->nz;
+    t->fast = t->dim3 && (t->dy.periodic || (t->dy.neumann && ny % 2 == 0)) &&
+              (t->dz.periodic || (t->dz.neumann && nz % 2 == 0));
+    t->ynn = t->fast && t->dy.neumann;
+    t->znn = t->fast && t->dz.neumann;
+    t->scale = t->fast ? 1.0 / ((double)ny * nz) : 1.0 / (t->dy.norm * t->dz.norm);
+
+    /* shape of a transformed plane and the eigenvalues of its rows/columns */
+    double *erow_all, *ecol_all;
+    if (t->dim3) {
+        t->TR = ny;
+        t->TC = t->fast || t->dz.periodic ? 2 * (nz / 2 + 1) : nz;
+        erow_all = xcalloc((size_t)t->TR, sizeof(double));
+        ecol_all = xcalloc((size_t)t->TC, sizeof(double));
+        for (int r = 0; r < t->TR; r++) erow_all[r] = t->dy.eig[r];
+        for (int c = 0; c < t->TC; c++) {
+            int k = c / 2;
+            if (t->znn) /* slot 2k: mode k; slot 2k+1: mode N−k (slot 1: empty, eigenvalue of mode 0) */
+                ecol_all[c] = t->dz.eig[c % 2 == 0 || k == 0 ? k : nz - k];
+            else
+                ecol_all[c] = t->dz.eig[t->dz.periodic ? k : c];
+        }
+    } else {
+        t->TR = t->dy.periodic ? ny / 2 + 1 : ny;
+        t->TC = t->dy.periodic ? 2 : 1;
+        erow_all = xcalloc((size_t)t->TR, sizeof(double));
+        ecol_all = xcalloc((size_t)t->TC, sizeof(double));
+        for (int r = 0; r < t->TR; r++) erow_all[r] = t->dy.eig[r];
+    }
+    int TR = t->TR, TC = t->TC;
+    t->wy = xcalloc((size_t)2 * (ny / 2 + 1), sizeof(double));
+    t->wz = xcalloc((size_t)2 * (nz / 2 + 1), sizeof(double));
+    for (int k = 0; k <= ny / 2; k++) {
+        t->wy[2 * k] = cos(M_PI * k / (2.0 * ny));
+        t->wy[2 * k + 1] = -sin(M_PI * k / (2.0 * ny));
+    }
+    for (int k = 0; k <= nz / 2; k++) {
+        t->wz[2 * k] = cos(M_PI * k / (2.0 * nz));
+        t->wz[2 * k + 1] = -sin(M_PI * k / (2.0 * nz));
+    }
 
     MPI_Comm_size(g->comm, &t->P);
     MPI_Comm_rank(g->comm, &t->me);
     int P = t->P;
     t->toff = xcalloc((size_t)nx, sizeof(long));
     t->trs = xcalloc((size_t)nx, sizeof(long));
-    t->rank = t->dim3 ? 2 : 1;
-    /* field side: y stride sy, z stride 1, planes sx */
-    t->fdims[0] = (fftw_iodim){ny, (int)g->sy, (int)g->sy};
-    t->fdims[1] = (fftw_iodim){nz, 1, 1};
-    t->fhow = (fftw_iodim){t->nxu, (int)g->sx, (int)g->sx};
+    long aux_size = t->ynn || t->znn ? (long)t->nxu * ny * nz : 0;
+    int owns_row0;
     if (P == 1) {
-        /* work[i][j][k]: the tridiagonal view is one row of ny·nz modes */
-        t->work = xcalloc((size_t)nx * ny * nz, sizeof(double));
-        t->wdims[0] = (fftw_iodim){ny, nz, nz};
-        t->wdims[1] = (fftw_iodim){nz, 1, 1};
-        t->whow = (fftw_iodim){t->nxu, ny * nz, ny * nz};
+        /* work[i][row][col]: the tridiagonal view is one row of TR·TC modes */
+        t->RS = TC;
+        t->PS = (long)TR * TC;
+        t->work = xcalloc((size_t)nx * TR * TC, sizeof(double));
+        if (aux_size) t->aux = xcalloc((size_t)aux_size, sizeof(double));
         t->tbuf = t->work;
-        for (int i = 0; i < nx; i++) t->toff[i] = (long)i * ny * nz;
+        for (int i = 0; i < nx; i++) t->toff[i] = (long)i * TR * TC;
         t->trows = 1;
-        t->tcols = ny * nz;
+        t->tcols = TR * TC;
         t->erow = xcalloc(1, sizeof(double));
-        t->ecol = xcalloc((size_t)ny * nz, sizeof(double));
-        for (int j = 0; j < ny; j++)
-            for (int k = 0; k < nz; k++) t->ecol[(long)j * nz + k] = t->dy.eig[j] + t->dz.eig[k];
-        t->owns_zero_mode = 1;
+        t->ecol = xcalloc((size_t)TR * TC, sizeof(double));
+        for (int r = 0; r < TR; r++)
+            for (int c = 0; c < TC; c++) t->ecol[(long)r * TC + c] = erow_all[r] + ecol_all[c];
+        owns_row0 = 1;
     } else {
-        /* work[j][il][k] (y modes outermost: each destination's block is
-         * contiguous); recv[s][jl][il][k] from each source slab s */
+        /* work[row][il][col] (rows outermost: each destination's block is
+         * contiguous); recv[s][rl][il][col] from each source slab s */
+        t->RS = (long)t->nxu * TC;
+        t->PS = TC;
         t->j0 = xcalloc((size_t)P + 1, sizeof(int));
         t->nyl = xcalloc((size_t)P, sizeof(int));
         t->nxu_r = xcalloc((size_t)P, sizeof(int));
@@ -234,50 +569,68 @@ static void *fft_create(poisson_t *p)
         t->sdispl = xcalloc((size_t)P, sizeof(int));
         t->rcount = xcalloc((size_t)P, sizeof(int));
         t->rdispl = xcalloc((size_t)P, sizeof(int));
-        for (int r = 0; r <= P; r++) t->j0[r] = (int)((long)r * ny / P);
+        for (int r = 0; r <= P; r++) t->j0[r] = (int)((long)r * TR / P);
         for (int r = 0; r < P; r++) t->nyl[r] = t->j0[r + 1] - t->j0[r];
         MPI_Allgather(&t->nxu, 1, MPI_INT, t->nxu_r, 1, MPI_INT, g->comm);
         int me = t->me, nyl = t->nyl[me];
         long disp = 0;
         for (int r = 0; r < P; r++) {
-            t->scount[r] = t->nyl[r] * t->nxu * nz;
-            t->sdispl[r] = t->j0[r] * t->nxu * nz;
-            t->rcount[r] = nyl * t->nxu_r[r] * nz;
+            t->scount[r] = t->nyl[r] * t->nxu * TC;
+            t->sdispl[r] = t->j0[r] * t->nxu * TC;
+            t->rcount[r] = nyl * t->nxu_r[r] * TC;
             t->rdispl[r] = (int)disp;
             disp += t->rcount[r];
         }
-        if ((long)ny * t->nxu * nz > 2147483647L || disp > 2147483647L)
+        if ((long)TR * t->nxu * TC > 2147483647L || disp > 2147483647L)
             die("poisson fft: a rank's share exceeds the MPI count range");
-        t->work = xcalloc((size_t)ny * (t->nxu > 0 ? t->nxu : 1) * nz, sizeof(double));
-        t->recv = xcalloc((size_t)(disp > 0 ? disp : 1), sizeof(double));
-        t->wdims[0] = (fftw_iodim){ny, t->nxu * nz, t->nxu * nz};
-        t->wdims[1] = (fftw_iodim){nz, 1, 1};
-        t->whow = (fftw_iodim){t->nxu, nz, nz};
+        t->work = xcalloc((size_t)TR * (t->nxu > 0 ? t->nxu : 1) * TC, sizeof(double));
+        /* the reordered copy is dead while the transposed data live: share */
+        long rsize = disp > aux_size ? disp : aux_size;
+        t->recv = xcalloc((size_t)(rsize > 0 ? rsize : 1), sizeof(double));
+        if (aux_size) t->aux = t->recv;
         t->tbuf = t->recv;
         int i = 0;
         for (int s = 0; s < P; s++)
             for (int il = 0; il < t->nxu_r[s]; il++, i++) {
-                t->toff[i] = t->rdispl[s] + (long)il * nz;
-                t->trs[i] = (long)t->nxu_r[s] * nz;
+                t->toff[i] = t->rdispl[s] + (long)il * TC;
+                t->trs[i] = (long)t->nxu_r[s] * TC;
             }
         if (i != nx) die("poisson fft: x planes of the ranks do not add up (%d != %d)", i, nx);
         t->trows = nyl;
-        t->tcols = nz;
+        t->tcols = TC;
         t->erow = xcalloc((size_t)(nyl > 0 ? nyl : 1), sizeof(double));
-        for (int r = 0; r < nyl; r++) t->erow[r] = t->dy.eig[t->j0[me] + r];
-        t->ecol = xcalloc((size_t)nz, sizeof(double));
-        memcpy(t->ecol, t->dz.eig, (size_t)nz * sizeof(double));
-        t->owns_zero_mode = t->j0[me] == 0 && nyl > 0;
+        for (int r = 0; r < nyl; r++) t->erow[r] = erow_all[t->j0[me] + r];
+        t->ecol = xcalloc((size_t)TC, sizeof(double));
+        memcpy(t->ecol, ecol_all, (size_t)TC * sizeof(double));
+        owns_row0 = t->j0[me] == 0 && nyl > 0;
     }
+    /* singular modes: eigenvalue exactly 0 (every direction periodic or
+     * Neumann; the imaginary/empty slot next to the zero mode holds 0) */
+    if (p->singular && owns_row0)
+        for (int c = 0; c < t->tcols && t->nzero < 4; c++)
+            if (t->erow[0] + t->ecol[c] == 0.0) t->zcol[t->nzero++] = c;
+    if (p->singular) {
+        /* left null vector of the x operator of a singular mode: w_{i+1} cw_{i+1}
+         * = w_i ce_i (the weighted row sums vanish), i.e. the cell volumes */
+        t->wx = xcalloc((size_t)nx, sizeof(double));
+        t->wx[0] = 1.0;
+        for (int i = 0; i + 1 < nx; i++) t->wx[i + 1] = t->wx[i] * p->ce[i] / p->cw[i + 1];
+    }
+    free(erow_all);
+    free(ecol_all);
     t->cp = xcalloc((size_t)nx * MODE_BLOCK, sizeof(double));
     t->zs = xcalloc((size_t)nx * MODE_BLOCK, sizeof(double));
     t->gam = xcalloc(MODE_BLOCK, sizeof(double));
-    t->zero_rhs = xcalloc((size_t)nx, sizeof(double));
+    t->zero_sol = xcalloc((size_t)4 * nx, sizeof(double));
     if (t->nxu > 0) {
+        setup_steps(t);
         /* plans for the alignment class of fields from field_alloc */
         double *f = field_alloc(g);
-        plan_for(t, 1, f + G_IDX(g, 0, 0, 0));
-        plan_for(t, 0, f + G_IDX(g, 0, 0, 0));
+        int a = fftw_alignment_of(f + G_IDX(g, 0, 0, 0)) != 0;
+        for (int k = 0; k < t->nsteps; k++) {
+            step_plan(t, &t->fwd[k], a);
+            step_plan(t, &t->inv[k], a);
+        }
         free(f);
     }
     return t;
@@ -406,29 +759,44 @@ static void tri_block_cyclic(fft_t *t, double lambda, int ra, int rb, int ca, in
         }
 }
 
-/* The singular mode: rows 0..n−2 with X_{n−1} = 0 (its coupling terms drop),
- * a plain Thomas solve; the remaining equation holds by compatibility. */
-static void solve_zero_mode(fft_t *t)
+/* A singular mode (eigenvalue 0, λ = 0), column c of row 0.  Its x system
+ * has the constant null vector and the left null vector w (wx): first project
+ * the right-hand side onto the compatible space (Σ w_i B_i = 0; in physical
+ * space this removes the weighted mean of b, as poisson_solve does for other
+ * back-ends), then solve rows 0..n−2 with X_{n−1} = 0 (its coupling terms drop:
+ * a plain Thomas solve; the last equation holds by compatibility), and shift
+ * the result to Σ w_i X_i = 0 (x of zero weighted mean). */
+static void solve_zero_mode(fft_t *t, int c, double *d)
 {
     const poisson_t *p = t->p;
     int n = t->nx;
-    double *d = t->zero_rhs, *c = t->cp;
+    double *cq = t->cp, *w = t->wx;
+    double sw = 0.0, swd = 0.0;
+    for (int i = 0; i < n; i++) {
+        d[i] = t->scale * t->tbuf[t->toff[i] + c];
+        sw += w[i];
+        swd += w[i] * d[i];
+    }
+    for (int i = 0; i < n; i++) d[i] -= swd / sw;
     for (int i = 0; i < n - 1; i++) {
         double a = i > 0 ? p->cw[i] : 0.0, b = -p->cd[i];
-        double den = i > 0 ? b - a * c[i - 1] : b;
-        c[i] = p->ce[i] / den;
-        d[i] = (t->scale * d[i] - (i > 0 ? a * d[i - 1] : 0.0)) / den;
+        double den = i > 0 ? b - a * cq[i - 1] : b;
+        cq[i] = p->ce[i] / den;
+        d[i] = (d[i] - (i > 0 ? a * d[i - 1] : 0.0)) / den;
     }
     d[n - 1] = 0.0;
-    for (int i = n - 3; i >= 0; i--) d[i] -= c[i] * d[i + 1];
-    for (int i = 0; i < n; i++) t->tbuf[t->toff[i]] = d[i];
+    for (int i = n - 3; i >= 0; i--) d[i] -= cq[i] * d[i + 1];
+    swd = 0.0;
+    for (int i = 0; i < n; i++) swd += w[i] * d[i];
+    for (int i = 0; i < n; i++) d[i] -= swd / sw;
 }
 
 static void tridiagonal_solves(fft_t *t, double lambda)
 {
-    int zero = t->p->singular && lambda == 0.0 && t->owns_zero_mode;
-    if (zero)
-        for (int i = 0; i < t->nx; i++) t->zero_rhs[i] = t->tbuf[t->toff[i]];
+    /* singular modes first, into zero_sol (the block solves below leave
+     * meaningless values in their columns, replaced afterwards) */
+    int nzero = lambda == 0.0 ? t->nzero : 0;
+    for (int z = 0; z < nzero; z++) solve_zero_mode(t, t->zcol[z], t->zero_sol + (long)z * t->nx);
     int nc = t->tcols < MODE_BLOCK ? t->tcols : MODE_BLOCK;
     int nr = MODE_BLOCK / nc;
     for (int ra = 0; ra < t->trows; ra += nr) {
@@ -443,7 +811,8 @@ static void tridiagonal_solves(fft_t *t, double lambda)
                 tri_block(t, lambda, ra, rb, ca, cb);
         }
     }
-    if (zero) solve_zero_mode(t);
+    for (int z = 0; z < nzero; z++)
+        for (int i = 0; i < t->nx; i++) t->tbuf[t->toff[i] + t->zcol[z]] = t->zero_sol[(long)z * t->nx + i];
 }
 
 static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, double *x)
@@ -451,7 +820,12 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
     fft_t *t = impl;
     const grid_t *g = p->g;
     long o = G_IDX(g, 0, 0, 0);
-    if (t->nxu > 0) fftw_execute_r2r(plan_for(t, 1, b + o), (double *)b + o, t->work);
+    int reord = t->ynn || t->znn;
+    if (t->nxu > 0) {
+        if (reord) reorder(t, (double *)b + o, 0);
+        for (int k = 0; k < t->nsteps; k++) step_run(t, &t->fwd[k], (double *)b + o);
+        if (reord) fast_butterfly(t, 0);
+    }
     if (t->P > 1)
         MPI_Alltoallv(t->work, t->scount, t->sdispl, MPI_DOUBLE, t->recv, t->rcount, t->rdispl, MPI_DOUBLE,
                       g->comm);
@@ -459,7 +833,11 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
     if (t->P > 1)
         MPI_Alltoallv(t->recv, t->rcount, t->rdispl, MPI_DOUBLE, t->work, t->scount, t->sdispl, MPI_DOUBLE,
                       g->comm);
-    if (t->nxu > 0) fftw_execute_r2r(plan_for(t, 0, x + o), t->work, x + o);
+    if (t->nxu > 0) {
+        if (reord) fast_butterfly(t, 1);
+        for (int k = 0; k < t->nsteps; k++) step_run(t, &t->inv[k], x + o);
+        if (reord) reorder(t, x + o, 1);
+    }
     /* boundary values of Dirichlet faces (not unknowns) are zero */
     int nz = g->n[2];
     if (t->ny < g->n[1])
@@ -480,10 +858,11 @@ static void fft_destroy(void *impl)
 {
     fft_t *t = impl;
     if (!t) return;
-    for (int a = 0; a < 2; a++) {
-        if (t->fwd[a]) fftw_destroy_plan(t->fwd[a]);
-        if (t->inv[a]) fftw_destroy_plan(t->inv[a]);
-    }
+    for (int k = 0; k < 2; k++)
+        for (int a = 0; a < 2; a++) {
+            if (t->fwd[k].plan[a]) fftw_destroy_plan(t->fwd[k].plan[a]);
+            if (t->inv[k].plan[a]) fftw_destroy_plan(t->inv[k].plan[a]);
+        }
     free(t->dy.eig);
     free(t->dz.eig);
     free(t->j0);
@@ -494,15 +873,19 @@ static void fft_destroy(void *impl)
     free(t->rcount);
     free(t->rdispl);
     free(t->work);
+    if (t->aux != t->recv) free(t->aux);
     free(t->recv);
+    free(t->wy);
+    free(t->wz);
     free(t->toff);
     free(t->trs);
     free(t->erow);
     free(t->ecol);
+    free(t->wx);
     free(t->cp);
     free(t->zs);
     free(t->gam);
-    free(t->zero_rhs);
+    free(t->zero_sol);
     free(t);
 }
 

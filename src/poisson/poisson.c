@@ -247,7 +247,7 @@ int poisson_solve(poisson_t *p, double lambda, const double *b, double *x)
 {
     const double *rhs = b;
     double *tmp = NULL;
-    int sing = p->singular && lambda == 0.0;
+    int sing = p->singular && lambda == 0.0 && !p->backend_handles_singular;
     if (sing) {
         /* Remove the incompatible part (weighted mean) of b. */
         double m = weighted_mean(p, b);
