@@ -330,15 +330,11 @@ static void reorder(fft_t *t, double *f, int inverse)
                 else
                     memcpy(ar, fr, (size_t)nz * sizeof(double));
             } else if (inverse) {
-                for (int m = 0; m < hz; m++) {
-                    fr[2 * m] = ar[m];
-                    fr[2 * m + 1] = ar[nz - 1 - m];
-                }
+                for (int m = 0; m < hz; m++) fr[2 * m] = ar[m];
+                for (int m = 0; m < hz; m++) fr[2 * m + 1] = ar[nz - 1 - m];
             } else {
-                for (int m = 0; m < hz; m++) {
-                    ar[m] = fr[2 * m];
-                    ar[nz - 1 - m] = fr[2 * m + 1];
-                }
+                for (int m = 0; m < hz; m++) ar[m] = fr[2 * m];
+                for (int m = 0; m < hz; m++) ar[nz - 1 - m] = fr[2 * m + 1];
             }
         }
 }
@@ -354,117 +350,154 @@ static void reorder(fft_t *t, double *f, int inverse)
  *      k1' their imaginary parts (same eigenvalue e_y(k1)).
  *  y Neumann, z periodic: a = βP, b = conj(β)Q, row k1 ← a+b, row k1' ← i(a−b)
  *      (complex, the y-cosine coefficients k1 and k1').
- * A row with k1' = k1 (k1 = 0 or N1/2) keeps its own outputs only; the
- * formulas follow from DCT_k = W^k V_k + W^{−k} V_{N−k} applied in each
- * direction and V(−k1, −k2) = conj V(k1, k2) for real data. */
+ * A row with k1' = k1 (k1 = 0 or N1/2) has Q = P and keeps its own outputs
+ * only.  The formulas follow from DCT_k = W^k V_k + W^{−k} V_{N−k} applied
+ * in each direction and V(−k1, −k2) = conj V(k1, k2) for real data.  Each
+ * case is a branch-free loop over k2 (vectorised). */
+static void bf_nn(double *restrict p, double *restrict q, const double *restrict w, int n, double br, double bi,
+                  int inverse)
+{
+    if (!inverse)
+        for (int k = 0; k < n; k++) {
+            double ar = w[2 * k], ai = w[2 * k + 1];
+            double Pr = p[2 * k], Pi = p[2 * k + 1], Qr = q[2 * k], Qi = q[2 * k + 1];
+            double a_r = ar * Pr - ai * Pi, a_i = ar * Pi + ai * Pr;
+            double b_r = ar * Qr - ai * Qi, b_i = -(ar * Qi + ai * Qr);
+            double Sr = a_r + b_r, Si = a_i + b_i, Dr = a_r - b_r, Di = a_i - b_i;
+            p[2 * k] = 2.0 * (br * Sr - bi * Si);
+            p[2 * k + 1] = -2.0 * (br * Di + bi * Dr);
+            q[2 * k] = -2.0 * (br * Si + bi * Sr);
+            q[2 * k + 1] = -2.0 * (br * Dr - bi * Di);
+        }
+    else
+        for (int k = 0; k < n; k++) {
+            double ar = w[2 * k], ai = w[2 * k + 1];
+            double sr = 0.5 * p[2 * k], di = -0.5 * p[2 * k + 1], si = -0.5 * q[2 * k], dr = -0.5 * q[2 * k + 1];
+            double Sr = br * sr + bi * si, Si = br * si - bi * sr, Dr = br * dr + bi * di, Di = br * di - bi * dr;
+            double a_r = 0.5 * (Sr + Dr), a_i = 0.5 * (Si + Di), b_r = 0.5 * (Sr - Dr), b_i = 0.5 * (Si - Di);
+            p[2 * k] = ar * a_r + ai * a_i;
+            p[2 * k + 1] = ar * a_i - ai * a_r;
+            q[2 * k] = ar * b_r - ai * b_i;
+            q[2 * k + 1] = -(ar * b_i + ai * b_r);
+        }
+}
+
+static void bf_nn_self(double *restrict p, const double *restrict w, int n, double br, double bi, int inverse)
+{
+    if (!inverse)
+        for (int k = 0; k < n; k++) {
+            double ar = w[2 * k], ai = w[2 * k + 1], Pr = p[2 * k], Pi = p[2 * k + 1];
+            double a_r = ar * Pr - ai * Pi, a_i = ar * Pi + ai * Pr;
+            /* b = conj(a): S = 2 Re a (real), D = 2i Im a */
+            double Sr = 2.0 * a_r, Di = 2.0 * a_i;
+            p[2 * k] = 2.0 * br * Sr;
+            p[2 * k + 1] = -2.0 * br * Di;
+        }
+    else {
+        double r = 0.5 / br;
+        for (int k = 0; k < n; k++) {
+            double ar = w[2 * k], ai = w[2 * k + 1];
+            double a_r = 0.5 * r * p[2 * k], a_i = -0.5 * r * p[2 * k + 1];
+            p[2 * k] = ar * a_r + ai * a_i;
+            p[2 * k + 1] = ar * a_i - ai * a_r;
+        }
+    }
+    (void)bi;
+}
+
+static void bf_zn(double *restrict p, double *restrict q, const double *restrict w, int n, int inverse)
+{
+    if (!inverse)
+        for (int k = 0; k < n; k++) {
+            double ar = w[2 * k], ai = w[2 * k + 1];
+            double Pr = p[2 * k], Pi = p[2 * k + 1], Qr = q[2 * k], Qi = q[2 * k + 1];
+            double a_r = ar * Pr - ai * Pi, a_i = ar * Pi + ai * Pr;
+            double b_r = ar * Qr - ai * Qi, b_i = -(ar * Qi + ai * Qr);
+            p[2 * k] = a_r + b_r;     /* Re T1 */
+            p[2 * k + 1] = b_i - a_i; /* Re T2 */
+            q[2 * k] = a_i + b_i;     /* Im T1 */
+            q[2 * k + 1] = a_r - b_r; /* Im T2 */
+        }
+    else
+        for (int k = 0; k < n; k++) {
+            double ar = w[2 * k], ai = w[2 * k + 1];
+            double T1r = p[2 * k], T2r = p[2 * k + 1], T1i = q[2 * k], T2i = q[2 * k + 1];
+            double a_r = 0.5 * (T1r + T2i), a_i = 0.5 * (T1i - T2r);
+            double b_r = 0.5 * (T1r - T2i), b_i = 0.5 * (T1i + T2r);
+            p[2 * k] = ar * a_r + ai * a_i;
+            p[2 * k + 1] = ar * a_i - ai * a_r;
+            q[2 * k] = ar * b_r - ai * b_i;
+            q[2 * k + 1] = -(ar * b_i + ai * b_r);
+        }
+}
+
+static void bf_zn_self(double *restrict p, const double *restrict w, int n, int inverse)
+{
+    if (!inverse)
+        for (int k = 0; k < n; k++) {
+            double ar = w[2 * k], ai = w[2 * k + 1], Pr = p[2 * k], Pi = p[2 * k + 1];
+            double a_r = ar * Pr - ai * Pi, a_i = ar * Pi + ai * Pr;
+            p[2 * k] = 2.0 * a_r;
+            p[2 * k + 1] = -2.0 * a_i;
+        }
+    else
+        for (int k = 0; k < n; k++) {
+            double ar = w[2 * k], ai = w[2 * k + 1];
+            double a_r = 0.5 * p[2 * k], a_i = -0.5 * p[2 * k + 1];
+            p[2 * k] = ar * a_r + ai * a_i;
+            p[2 * k + 1] = ar * a_i - ai * a_r;
+        }
+}
+
+static void bf_yn(double *restrict p, double *restrict q, int n, double br, double bi, int inverse)
+{
+    if (!inverse)
+        for (int k = 0; k < n; k++) {
+            double Pr = p[2 * k], Pi = p[2 * k + 1], Qr = q[2 * k], Qi = q[2 * k + 1];
+            double a_r = br * Pr - bi * Pi, a_i = br * Pi + bi * Pr;
+            double b_r = br * Qr + bi * Qi, b_i = br * Qi - bi * Qr;
+            p[2 * k] = a_r + b_r;
+            p[2 * k + 1] = a_i + b_i;
+            q[2 * k] = b_i - a_i;
+            q[2 * k + 1] = a_r - b_r;
+        }
+    else
+        for (int k = 0; k < n; k++) {
+            double U1r = p[2 * k], U1i = p[2 * k + 1], U2r = q[2 * k], U2i = q[2 * k + 1];
+            double a_r = 0.5 * (U1r + U2i), a_i = 0.5 * (U1i - U2r);
+            double b_r = 0.5 * (U1r - U2i), b_i = 0.5 * (U1i + U2r);
+            p[2 * k] = br * a_r + bi * a_i;
+            p[2 * k + 1] = br * a_i - bi * a_r;
+            q[2 * k] = br * b_r - bi * b_i;
+            q[2 * k + 1] = br * b_i + bi * b_r;
+        }
+}
+
 static void fast_butterfly(fft_t *t, int inverse)
 {
-    int N1 = t->ny, H2 = t->nz / 2;
+    int N1 = t->ny, n = t->nz / 2 + 1;
     const double *wy = t->wy, *wz = t->wz;
     for (int i = 0; i < t->nxu; i++)
         for (int k1 = 0; k1 <= N1 / 2; k1++) {
-            int k1p = k1 ? N1 - k1 : 0, self = k1p == k1;
-            double *restrict p = t->work + i * t->PS + k1 * t->RS;
-            double *restrict q = t->work + i * t->PS + k1p * t->RS;
-            if (self) q = p;
-            const double br = wy[2 * k1], bi = wy[2 * k1 + 1];
-            if (t->ynn && t->znn) {
-                if (!inverse)
-                    for (int k = 0; k <= H2; k++) {
-                        double ar = wz[2 * k], ai = wz[2 * k + 1];
-                        double Pr = p[2 * k], Pi = p[2 * k + 1], Qr = q[2 * k], Qi = q[2 * k + 1];
-                        double a_r = ar * Pr - ai * Pi, a_i = ar * Pi + ai * Pr;
-                        double b_r = ar * Qr - ai * Qi, b_i = -(ar * Qi + ai * Qr);
-                        double Sr = a_r + b_r, Si = a_i + b_i, Dr = a_r - b_r, Di = a_i - b_i;
-                        double sr = br * Sr - bi * Si, si = br * Si + bi * Sr;
-                        double dr = br * Dr - bi * Di, di = br * Di + bi * Dr;
-                        p[2 * k] = 2.0 * sr;
-                        p[2 * k + 1] = -2.0 * di;
-                        if (!self) {
-                            q[2 * k] = -2.0 * si;
-                            q[2 * k + 1] = -2.0 * dr;
-                        }
-                    }
-                else
-                    for (int k = 0; k <= H2; k++) {
-                        double ar = wz[2 * k], ai = wz[2 * k + 1];
-                        double Y1 = p[2 * k], Y2 = p[2 * k + 1], Sr, Si, Dr, Di;
-                        if (!self) {
-                            double Y3 = q[2 * k], Y4 = q[2 * k + 1];
-                            double sr = 0.5 * Y1, si = -0.5 * Y3, dr = -0.5 * Y4, di = -0.5 * Y2;
-                            Sr = br * sr + bi * si;
-                            Si = br * si - bi * sr;
-                            Dr = br * dr + bi * di;
-                            Di = br * di - bi * dr;
-                        } else {
-                            double r = 0.5 / br;
-                            Sr = Y1 * r;
-                            Si = 0.0;
-                            Dr = 0.0;
-                            Di = -Y2 * r;
-                        }
-                        double a_r = 0.5 * (Sr + Dr), a_i = 0.5 * (Si + Di);
-                        double b_r = 0.5 * (Sr - Dr), b_i = 0.5 * (Si - Di);
-                        p[2 * k] = ar * a_r + ai * a_i;
-                        p[2 * k + 1] = ar * a_i - ai * a_r;
-                        if (!self) {
-                            q[2 * k] = ar * b_r - ai * b_i;
-                            q[2 * k + 1] = -(ar * b_i + ai * b_r);
-                        }
-                    }
-            } else if (t->znn) {
-                if (!inverse)
-                    for (int k = 0; k <= H2; k++) {
-                        double ar = wz[2 * k], ai = wz[2 * k + 1];
-                        double Pr = p[2 * k], Pi = p[2 * k + 1], Qr = q[2 * k], Qi = q[2 * k + 1];
-                        double a_r = ar * Pr - ai * Pi, a_i = ar * Pi + ai * Pr;
-                        double b_r = ar * Qr - ai * Qi, b_i = -(ar * Qi + ai * Qr);
-                        p[2 * k] = a_r + b_r;       /* Re T1 */
-                        p[2 * k + 1] = b_i - a_i;   /* Re T2 */
-                        if (!self) {
-                            q[2 * k] = a_i + b_i;   /* Im T1 */
-                            q[2 * k + 1] = a_r - b_r; /* Im T2 */
-                        }
-                    }
-                else
-                    for (int k = 0; k <= H2; k++) {
-                        double ar = wz[2 * k], ai = wz[2 * k + 1];
-                        double T1r = p[2 * k], T2r = p[2 * k + 1];
-                        double T1i = self ? 0.0 : q[2 * k], T2i = self ? 0.0 : q[2 * k + 1];
-                        double a_r = 0.5 * (T1r + T2i), a_i = 0.5 * (T1i - T2r);
-                        double b_r = 0.5 * (T1r - T2i), b_i = 0.5 * (T1i + T2r);
-                        p[2 * k] = ar * a_r + ai * a_i;
-                        p[2 * k + 1] = ar * a_i - ai * a_r;
-                        if (!self) {
-                            q[2 * k] = ar * b_r - ai * b_i;
-                            q[2 * k + 1] = -(ar * b_i + ai * b_r);
-                        }
-                    }
-            } else {
-                if (self) {
+            int k1p = k1 ? N1 - k1 : 0;
+            double *p = t->work + i * t->PS + k1 * t->RS, *q = t->work + i * t->PS + k1p * t->RS;
+            double br = wy[2 * k1], bi = wy[2 * k1 + 1];
+            if (k1p == k1) {
+                if (t->ynn && t->znn)
+                    bf_nn_self(p, wz, n, br, bi, inverse);
+                else if (t->znn)
+                    bf_zn_self(p, wz, n, inverse);
+                else {
+                    /* y cosine coefficient k1 of a self-paired row: (β + conj β) P */
                     double f = inverse ? 0.5 / br : 2.0 * br;
-                    for (int k = 0; k < 2 * H2 + 2; k++) p[k] *= f;
-                } else if (!inverse)
-                    for (int k = 0; k <= H2; k++) {
-                        double Pr = p[2 * k], Pi = p[2 * k + 1], Qr = q[2 * k], Qi = q[2 * k + 1];
-                        double a_r = br * Pr - bi * Pi, a_i = br * Pi + bi * Pr;
-                        double b_r = br * Qr + bi * Qi, b_i = br * Qi - bi * Qr;
-                        p[2 * k] = a_r + b_r;
-                        p[2 * k + 1] = a_i + b_i;
-                        q[2 * k] = b_i - a_i;
-                        q[2 * k + 1] = a_r - b_r;
-                    }
-                else
-                    for (int k = 0; k <= H2; k++) {
-                        double U1r = p[2 * k], U1i = p[2 * k + 1], U2r = q[2 * k], U2i = q[2 * k + 1];
-                        double a_r = 0.5 * (U1r + U2i), a_i = 0.5 * (U1i - U2r);
-                        double b_r = 0.5 * (U1r - U2i), b_i = 0.5 * (U1i + U2r);
-                        p[2 * k] = br * a_r + bi * a_i;
-                        p[2 * k + 1] = br * a_i - bi * a_r;
-                        q[2 * k] = br * b_r - bi * b_i;
-                        q[2 * k + 1] = br * b_i + bi * b_r;
-                    }
-            }
+                    for (int k = 0; k < 2 * n; k++) p[k] *= f;
+                }
+            } else if (t->ynn && t->znn)
+                bf_nn(p, q, wz, n, br, bi, inverse);
+            else if (t->znn)
+                bf_zn(p, q, wz, n, inverse);
+            else
+                bf_yn(p, q, n, br, bi, inverse);
         }
 }
 
