@@ -79,7 +79,7 @@ typedef struct {
 
 /* One batched transform of the pipeline (an FFTW guru plan). */
 typedef enum { TK_R2R, TK_R2C, TK_C2R, TK_C2C } tkind_t;
-typedef enum { SIDE_FIELD, SIDE_WORK, SIDE_AUX } side_t;
+typedef enum { SIDE_FIELD, SIDE_WORK } side_t;
 typedef struct {
     tkind_t kind;
     int sign;                  /* TK_C2C: FFTW_FORWARD or FFTW_BACKWARD */
@@ -109,10 +109,15 @@ typedef struct {
     long RS, PS;
     step_t fwd[2], inv[2];     /* forward: [0] then [1]; inverse: [0] then [1] */
     int nsteps;
-    /* fast path: 2-D r2c with Makhoul reordering of the Neumann directions */
-    int fast, ynn, znn;
-    double *aux;               /* reordered copy of the data (fast path with a Neumann direction) */
+    /* fast path: 2-D DFT with Makhoul reordering of the Neumann directions */
+    int fast, ynn, znn, reord; /* reord = ynn || znn */
+    int fused;                 /* butterflies applied inside the tridiagonal sweeps (one rank) */
     double *wy, *wz;           /* twiddles e^{−iπk/2N} (re, im) */
+    /* reordering fast path: the z transforms run on chunks of zc rows
+     * gathered (reordered) into zbuf, small enough to stay in cache */
+    int zc;
+    double *zbuf;
+    fftw_plan zcf[2], zci[2];  /* r2c / c2r of a full chunk [0] and of the remainder [1] */
 
     /* decomposition of the rows among ranks (P > 1) */
     int P, me;
@@ -130,6 +135,7 @@ typedef struct {
     double *wx;                /* compatibility weights in x (singular problems) */
 
     double *cp, *zs, *gam;     /* scratch of one block */
+    int *rowlist;              /* rows of one block */
     double *zero_sol;          /* solutions of the singular modes (nzero × nx) */
 } fft_t;
 
@@ -213,7 +219,7 @@ static void step_plan(fft_t *t, step_t *s, int a)
         f = tmp + G_IDX(g, 0, 0, 0);
         if ((fftw_alignment_of(f) != 0) != a) f++;
     }
-    double *side[3] = {f, t->work, t->aux};
+    double *side[2] = {f, t->work};
     double *in = side[s->in], *out = side[s->out];
     unsigned flags = t->plan_flags | (s->in == SIDE_FIELD ? FFTW_PRESERVE_INPUT : FFTW_DESTROY_INPUT);
     fftw_plan pl = NULL;
@@ -241,7 +247,7 @@ static void step_run(fft_t *t, step_t *s, double *f)
 {
     int a = (s->in == SIDE_FIELD || s->out == SIDE_FIELD) ? fftw_alignment_of(f) != 0 : 0;
     if (!s->plan[a]) step_plan(t, s, a);
-    double *side[3] = {f, t->work, t->aux};
+    double *side[2] = {f, t->work};
     double *in = side[s->in], *out = side[s->out];
     fftw_plan pl = s->plan[a];
     switch (s->kind) {
@@ -253,8 +259,9 @@ static void step_run(fft_t *t, step_t *s, double *f)
 }
 
 /* The transform pipeline.
- * Fast path: one 2-D r2c over (y, z) per x plane (from the field, or from
- * the reordered copy aux when a direction is Neumann), c2r back.
+ * Fast path: one 2-D r2c over (y, z) per x plane when both are periodic;
+ * with a Neumann direction, the z r2c of reordered row chunks (z_chunks)
+ * then a complex DFT along y in place.
  * General 3-D: z first (field → work; r2c when z is periodic, so its output
  * is complex and the y step is a complex DFT if y is periodic too, else the
  * r2r kind of z), then y in place (r2r kind of y, on every double).  2-D: y
@@ -265,15 +272,19 @@ static void setup_steps(fft_t *t)
     long sx = g->sx, sy = g->sy, RS = t->RS, PS = t->PS;
     int nxu = t->nxu, ny = t->ny, nz = t->nz, TC = t->TC;
     fftw_iodim none = {0, 0, 0};
-    if (t->fast) {
+    if (t->fast && !t->reord) {
+        /* both periodic: one 2-D r2c from the field */
         t->nsteps = 1;
-        int reorder = t->ynn || t->znn;
-        side_t src = reorder ? SIDE_AUX : SIDE_FIELD;
-        long isy = reorder ? nz : sy, isx = reorder ? (long)ny * nz : sx;
-        t->fwd[0] = step_make(TK_R2C, 0, 0, src, SIDE_WORK, 2, iod(ny, isy, RS / 2), iod(nz, 1, 1), 1,
-                              iod(nxu, isx, PS / 2), none);
-        t->inv[0] = step_make(TK_C2R, 0, 0, SIDE_WORK, src, 2, iod(ny, RS / 2, isy), iod(nz, 1, 1), 1,
-                              iod(nxu, PS / 2, isx), none);
+        t->fwd[0] = step_make(TK_R2C, 0, 0, SIDE_FIELD, SIDE_WORK, 2, iod(ny, sy, RS / 2), iod(nz, 1, 1), 1,
+                              iod(nxu, sx, PS / 2), none);
+        t->inv[0] = step_make(TK_C2R, 0, 0, SIDE_WORK, SIDE_FIELD, 2, iod(ny, RS / 2, sy), iod(nz, 1, 1), 1,
+                              iod(nxu, PS / 2, sx), none);
+    } else if (t->fast) {
+        /* z: r2c of reordered chunks (z_chunks); y: complex DFT in place */
+        t->nsteps = 1;
+        fftw_iodim d = iod(ny, RS / 2, RS / 2), h0 = iod(nxu, PS / 2, PS / 2), h1 = iod(TC / 2, 1, 1);
+        t->fwd[0] = step_make(TK_C2C, 0, FFTW_FORWARD, SIDE_WORK, SIDE_WORK, 1, d, none, 2, h0, h1);
+        t->inv[0] = step_make(TK_C2C, 0, FFTW_BACKWARD, SIDE_WORK, SIDE_WORK, 1, d, none, 2, h0, h1);
     } else if (t->dim3) {
         t->nsteps = 2;
         if (t->dz.periodic) {
@@ -312,31 +323,56 @@ static void setup_steps(fft_t *t)
     }
 }
 
-/* Makhoul reordering of the Neumann directions: aux[i][n1][n2] =
- * f[i][p_y(n1)][p_z(n2)] with p(n) = 2n for n < N/2, p(N−1−n) = 2n+1
- * (identity for a periodic direction); inverse = 1 scatters back. */
-static void reorder(fft_t *t, double *f, int inverse)
+/* z transforms of the reordering fast path, in chunks of zc rows of a plane.
+ * Forward: gather the rows reordered (Makhoul: v(n) = x(2n), v(N−1−n) =
+ * x(2n+1) in each Neumann direction; row n1 of the output comes from field
+ * row p_y(n1)) into zbuf, which stays in cache, then r2c into the work rows.
+ * Inverse: c2r of the work rows into zbuf, scattered back.  This costs no
+ * extra pass over memory compared with a transform from the field. */
+static void z_chunks(fft_t *t, double *f, int inverse)
 {
     const grid_t *g = t->p->g;
     int ny = t->ny, nz = t->nz, hz = nz / 2;
+    long o = G_IDX(g, 0, 0, 0);
     for (int i = 0; i < t->nxu; i++)
-        for (int n1 = 0; n1 < ny; n1++) {
-            int j = !t->ynn ? n1 : n1 < ny / 2 ? 2 * n1 : 2 * (ny - 1 - n1) + 1;
-            double *restrict fr = f + G_IDX(g, i, j, 0) - G_IDX(g, 0, 0, 0);
-            double *restrict ar = t->aux + ((long)i * ny + n1) * nz;
-            if (!t->znn) {
-                if (inverse)
-                    memcpy(fr, ar, (size_t)nz * sizeof(double));
-                else
-                    memcpy(ar, fr, (size_t)nz * sizeof(double));
-            } else if (inverse) {
-                for (int m = 0; m < hz; m++) fr[2 * m] = ar[m];
-                for (int m = 0; m < hz; m++) fr[2 * m + 1] = ar[nz - 1 - m];
-            } else {
-                for (int m = 0; m < hz; m++) ar[m] = fr[2 * m];
-                for (int m = 0; m < hz; m++) ar[nz - 1 - m] = fr[2 * m + 1];
+        for (int r0 = 0; r0 < ny; r0 += t->zc) {
+            int cnt = r0 + t->zc <= ny ? t->zc : ny - r0, pl = cnt == t->zc ? 0 : 1;
+            fftw_complex *w = (fftw_complex *)(t->work + i * t->PS + r0 * t->RS);
+            if (inverse) fftw_execute_dft_c2r(t->zci[pl], w, t->zbuf);
+            for (int r = 0; r < cnt; r++) {
+                int n1 = r0 + r, j = !t->ynn ? n1 : n1 < ny / 2 ? 2 * n1 : 2 * (ny - 1 - n1) + 1;
+                double *restrict fr = f + G_IDX(g, i, j, 0) - o;
+                double *restrict zr = t->zbuf + (long)r * nz;
+                if (!t->znn) {
+                    if (inverse)
+                        memcpy(fr, zr, (size_t)nz * sizeof(double));
+                    else
+                        memcpy(zr, fr, (size_t)nz * sizeof(double));
+                } else if (inverse) {
+                    for (int m = 0; m < hz; m++) fr[2 * m] = zr[m];
+                    for (int m = 0; m < hz; m++) fr[2 * m + 1] = zr[nz - 1 - m];
+                } else {
+                    for (int m = 0; m < hz; m++) zr[m] = fr[2 * m];
+                    for (int m = 0; m < hz; m++) zr[nz - 1 - m] = fr[2 * m + 1];
+                }
             }
+            if (!inverse) fftw_execute_dft_r2c(t->zcf[pl], t->zbuf, w);
         }
+}
+
+static void z_chunk_plans(fft_t *t)
+{
+    int nz = t->nz, rem = t->ny % t->zc;
+    for (int pl = 0; pl < 2; pl++) {
+        int cnt = pl ? rem : t->zc;
+        if (cnt == 0) continue;
+        fftw_iodim d = iod(nz, 1, 1), hf = iod(cnt, nz, t->RS / 2), hi = iod(cnt, t->RS / 2, nz);
+        t->zcf[pl] = fftw_plan_guru_dft_r2c(1, &d, 1, &hf, t->zbuf, (fftw_complex *)t->work,
+                                            t->plan_flags | FFTW_DESTROY_INPUT);
+        t->zci[pl] = fftw_plan_guru_dft_c2r(1, &d, 1, &hi, (fftw_complex *)t->work, t->zbuf,
+                                            t->plan_flags | FFTW_DESTROY_INPUT);
+        if (!t->zcf[pl] || !t->zci[pl]) die("poisson fft: FFTW could not plan a transform");
+    }
 }
 
 /* The pass that turns the 2-D DFT V of the reordered data into the cosine
@@ -473,31 +509,40 @@ static void bf_yn(double *restrict p, double *restrict q, int n, double br, doub
         }
 }
 
+/* Butterfly of rows k1 (p) and N1−k1 (q; NULL when the row pairs with
+ * itself) over n complex entries starting at z index k2 = c0. */
+static void bf_apply(const fft_t *t, double *p, double *q, int n, int c0, int k1, int inverse)
+{
+    const double *wz = t->wz + 2 * c0;
+    double br = t->wy[2 * k1], bi = t->wy[2 * k1 + 1];
+    if (!q) {
+        if (t->ynn && t->znn)
+            bf_nn_self(p, wz, n, br, bi, inverse);
+        else if (t->znn)
+            bf_zn_self(p, wz, n, inverse);
+        else {
+            /* y cosine coefficient k1 of a self-paired row: (β + conj β) P */
+            double f = inverse ? 0.5 / br : 2.0 * br;
+            for (int k = 0; k < 2 * n; k++) p[k] *= f;
+        }
+    } else if (t->ynn && t->znn)
+        bf_nn(p, q, wz, n, br, bi, inverse);
+    else if (t->znn)
+        bf_zn(p, q, wz, n, inverse);
+    else
+        bf_yn(p, q, n, br, bi, inverse);
+}
+
+/* The butterfly as a pass over the local planes (when the tridiagonal
+ * sweeps cannot do it on the fly: rows k1 and N1−k1 on different ranks). */
 static void fast_butterfly(fft_t *t, int inverse)
 {
     int N1 = t->ny, n = t->nz / 2 + 1;
-    const double *wy = t->wy, *wz = t->wz;
     for (int i = 0; i < t->nxu; i++)
         for (int k1 = 0; k1 <= N1 / 2; k1++) {
             int k1p = k1 ? N1 - k1 : 0;
             double *p = t->work + i * t->PS + k1 * t->RS, *q = t->work + i * t->PS + k1p * t->RS;
-            double br = wy[2 * k1], bi = wy[2 * k1 + 1];
-            if (k1p == k1) {
-                if (t->ynn && t->znn)
-                    bf_nn_self(p, wz, n, br, bi, inverse);
-                else if (t->znn)
-                    bf_zn_self(p, wz, n, inverse);
-                else {
-                    /* y cosine coefficient k1 of a self-paired row: (β + conj β) P */
-                    double f = inverse ? 0.5 / br : 2.0 * br;
-                    for (int k = 0; k < 2 * n; k++) p[k] *= f;
-                }
-            } else if (t->ynn && t->znn)
-                bf_nn(p, q, wz, n, br, bi, inverse);
-            else if (t->znn)
-                bf_zn(p, q, wz, n, inverse);
-            else
-                bf_yn(p, q, n, br, bi, inverse);
+            bf_apply(t, p, k1p == k1 ? NULL : q, n, 0, k1, inverse);
         }
 }
 
@@ -532,6 +577,7 @@ static void *fft_create(poisson_t *p)
               (t->dz.periodic || (t->dz.neumann && nz % 2 == 0));
     t->ynn = t->fast && t->dy.neumann;
     t->znn = t->fast && t->dz.neumann;
+    t->reord = t->ynn || t->znn;
     t->scale = t->fast ? 1.0 / ((double)ny * nz) : 1.0 / (t->dy.norm * t->dz.norm);
 
     /* shape of a transformed plane and the eigenvalues of its rows/columns */
@@ -573,22 +619,32 @@ static void *fft_create(poisson_t *p)
     int P = t->P;
     t->toff = xcalloc((size_t)nx, sizeof(long));
     t->trs = xcalloc((size_t)nx, sizeof(long));
-    long aux_size = t->ynn || t->znn ? (long)t->nxu * ny * nz : 0;
     int owns_row0;
+    t->fused = P == 1 && t->reord;
     if (P == 1) {
-        /* work[i][row][col]: the tridiagonal view is one row of TR·TC modes */
+        /* work[i][row][col] */
         t->RS = TC;
         t->PS = (long)TR * TC;
         t->work = xcalloc((size_t)nx * TR * TC, sizeof(double));
-        if (aux_size) t->aux = xcalloc((size_t)aux_size, sizeof(double));
         t->tbuf = t->work;
         for (int i = 0; i < nx; i++) t->toff[i] = (long)i * TR * TC;
-        t->trows = 1;
-        t->tcols = TR * TC;
-        t->erow = xcalloc(1, sizeof(double));
-        t->ecol = xcalloc((size_t)TR * TC, sizeof(double));
-        for (int r = 0; r < TR; r++)
-            for (int c = 0; c < TC; c++) t->ecol[(long)r * TC + c] = erow_all[r] + ecol_all[c];
+        if (t->fused) {
+            /* rows and columns: blocks pair row k1 with N1−k1 for the butterfly */
+            for (int i = 0; i < nx; i++) t->trs[i] = TC;
+            t->trows = TR;
+            t->tcols = TC;
+            t->erow = erow_all;
+            t->ecol = ecol_all;
+            erow_all = ecol_all = NULL;
+        } else {
+            /* one row of TR·TC modes */
+            t->trows = 1;
+            t->tcols = TR * TC;
+            t->erow = xcalloc(1, sizeof(double));
+            t->ecol = xcalloc((size_t)TR * TC, sizeof(double));
+            for (int r = 0; r < TR; r++)
+                for (int c = 0; c < TC; c++) t->ecol[(long)r * TC + c] = erow_all[r] + ecol_all[c];
+        }
         owns_row0 = 1;
     } else {
         /* work[row][il][col] (rows outermost: each destination's block is
@@ -617,10 +673,7 @@ static void *fft_create(poisson_t *p)
         if ((long)TR * t->nxu * TC > 2147483647L || disp > 2147483647L)
             die("poisson fft: a rank's share exceeds the MPI count range");
         t->work = xcalloc((size_t)TR * (t->nxu > 0 ? t->nxu : 1) * TC, sizeof(double));
-        /* the reordered copy is dead while the transposed data live: share */
-        long rsize = disp > aux_size ? disp : aux_size;
-        t->recv = xcalloc((size_t)(rsize > 0 ? rsize : 1), sizeof(double));
-        if (aux_size) t->aux = t->recv;
+        t->recv = xcalloc((size_t)(disp > 0 ? disp : 1), sizeof(double));
         t->tbuf = t->recv;
         int i = 0;
         for (int s = 0; s < P; s++)
@@ -655,7 +708,17 @@ static void *fft_create(poisson_t *p)
     t->zs = xcalloc((size_t)nx * MODE_BLOCK, sizeof(double));
     t->gam = xcalloc(MODE_BLOCK, sizeof(double));
     t->zero_sol = xcalloc((size_t)4 * nx, sizeof(double));
+    t->rowlist = xcalloc(MODE_BLOCK, sizeof(int));
+    if (t->fused && p->singular && !(t->nzero == 2 && t->zcol[0] == 0 && t->zcol[1] == 1))
+        die("poisson fft: unexpected singular modes");
     if (t->nxu > 0) {
+        if (t->reord) {
+            /* chunks of about 8192 doubles (64 KB: in cache) */
+            t->zc = 8192 / nz > 0 ? 8192 / nz : 1;
+            if (t->zc > ny) t->zc = ny;
+            t->zbuf = xcalloc((size_t)t->zc * nz, sizeof(double));
+            z_chunk_plans(t);
+        }
         setup_steps(t);
         /* plans for the alignment class of fields from field_alloc */
         double *f = field_alloc(g);
@@ -669,19 +732,41 @@ static void *fft_create(poisson_t *p)
     return t;
 }
 
-/* Thomas algorithm for the modes (rows ra..rb−1, cols ca..cb−1) of the view,
- * non-periodic x.  The right-hand side is scaled by s (transform norm). */
-static void tri_block(fft_t *t, double lambda, int ra, int rb, int ca, int cb)
+/* A block of modes for the tridiagonal sweeps: rows row[0..nr−1] of the
+ * view, columns ca..cb−1.  With the fused butterfly (one rank, reordering
+ * fast path) a block is the row pair k1, N1−k1 (or the self-paired row k1),
+ * and the butterfly is applied to each x plane of the block as the forward
+ * sweep reaches it, its inverse as the backward sweep leaves it. */
+typedef struct {
+    const int *row;
+    int nr, ca, cb;
+    int bf, k1; /* bf: 1 = apply the butterfly of rows k1 (and row[1]) */
+} block_t;
+
+static inline double *blk_row(const fft_t *t, int i, int r, int ca) { return t->tbuf + t->toff[i] + r * t->trs[i] + ca; }
+
+static void blk_butterfly(const fft_t *t, const block_t *B, int i, int inverse)
+{
+    if (!B->bf) return;
+    double *p = blk_row(t, i, B->row[0], B->ca), *q = B->nr > 1 ? blk_row(t, i, B->row[1], B->ca) : NULL;
+    bf_apply(t, p, q, (B->cb - B->ca) / 2, B->ca / 2, B->k1, inverse);
+}
+
+/* Thomas algorithm for the modes of a block, non-periodic x.  The
+ * right-hand side is scaled by s (transform norm). */
+static void tri_block(fft_t *t, double lambda, const block_t *B)
 {
     const poisson_t *p = t->p;
-    const int n = t->nx, nc = cb - ca;
+    const int n = t->nx, ca = B->ca, nc = B->cb - B->ca;
     const double s = t->scale;
     double *restrict cp = t->cp;
     for (int i = 0; i < n; i++) {
         const double a = p->cw[i], c = p->ce[i], dd = -p->cd[i] - lambda;
-        for (int r = ra; r < rb; r++) {
-            double *restrict xi = t->tbuf + t->toff[i] + r * t->trs[i] + ca;
-            double *restrict ci = cp + (long)i * MODE_BLOCK + (long)(r - ra) * nc;
+        blk_butterfly(t, B, i, 0);
+        for (int q = 0; q < B->nr; q++) {
+            int r = B->row[q];
+            double *restrict xi = blk_row(t, i, r, ca);
+            double *restrict ci = cp + (long)i * MODE_BLOCK + (long)q * nc;
             const double er = t->erow[r] + dd, *restrict ec = t->ecol + ca;
             if (i == 0) {
                 for (int k = 0; k < nc; k++) {
@@ -690,7 +775,7 @@ static void tri_block(fft_t *t, double lambda, int ra, int rb, int ca, int cb)
                     xi[k] *= s * inv;
                 }
             } else {
-                const double *restrict xm = t->tbuf + t->toff[i - 1] + r * t->trs[i - 1] + ca;
+                const double *restrict xm = blk_row(t, i - 1, r, ca);
                 const double *restrict cm = ci - MODE_BLOCK;
                 for (int k = 0; k < nc; k++) {
                     double inv = 1.0 / (er + ec[k] - a * cm[k]);
@@ -700,13 +785,17 @@ static void tri_block(fft_t *t, double lambda, int ra, int rb, int ca, int cb)
             }
         }
     }
-    for (int i = n - 2; i >= 0; i--)
-        for (int r = ra; r < rb; r++) {
-            double *restrict xi = t->tbuf + t->toff[i] + r * t->trs[i] + ca;
-            const double *restrict xp = t->tbuf + t->toff[i + 1] + r * t->trs[i + 1] + ca;
-            const double *restrict ci = cp + (long)i * MODE_BLOCK + (long)(r - ra) * nc;
+    for (int i = n - 2; i >= 0; i--) {
+        for (int q = 0; q < B->nr; q++) {
+            int r = B->row[q];
+            double *restrict xi = blk_row(t, i, r, ca);
+            const double *restrict xp = blk_row(t, i + 1, r, ca);
+            const double *restrict ci = cp + (long)i * MODE_BLOCK + (long)q * nc;
             for (int k = 0; k < nc; k++) xi[k] -= ci[k] * xp[k];
         }
+        blk_butterfly(t, B, i + 1, 1);
+    }
+    blk_butterfly(t, B, 0, 1);
 }
 
 /* Cyclic tridiagonal (periodic x, a_0 = cw[0] couples X_0 to X_{n−1} and
@@ -714,17 +803,19 @@ static void tri_block(fft_t *t, double lambda, int ra, int rb, int ca, int cb)
  * γ = −b_0, A = A' + u vᵀ where u = (γ, 0, …, 0, c_{n−1}), v = (1, 0, …, 0,
  * a_0/γ) and A' is tridiagonal with b'_0 = b_0 − γ, b'_{n−1} = b_{n−1} −
  * a_0 c_{n−1}/γ.  Solve A'y = d, A'z = u; X = y − (v·y)/(1 + v·z) z. */
-static void tri_block_cyclic(fft_t *t, double lambda, int ra, int rb, int ca, int cb)
+static void tri_block_cyclic(fft_t *t, double lambda, const block_t *B)
 {
     const poisson_t *p = t->p;
-    const int n = t->nx, nc = cb - ca;
+    const int n = t->nx, ca = B->ca, nc = B->cb - B->ca;
     const double s = t->scale, a0 = p->cw[0], cn = p->ce[n - 1];
     double *restrict cp = t->cp, *restrict zs = t->zs, *restrict gam = t->gam;
     for (int i = 0; i < n; i++) {
         const double a = p->cw[i], c = p->ce[i], dd = -p->cd[i] - lambda;
-        for (int r = ra; r < rb; r++) {
-            long m0 = (long)(r - ra) * nc;
-            double *restrict xi = t->tbuf + t->toff[i] + r * t->trs[i] + ca;
+        blk_butterfly(t, B, i, 0);
+        for (int q = 0; q < B->nr; q++) {
+            int r = B->row[q];
+            long m0 = (long)q * nc;
+            double *restrict xi = blk_row(t, i, r, ca);
             double *restrict ci = cp + (long)i * MODE_BLOCK + m0, *restrict zi = zs + (long)i * MODE_BLOCK + m0;
             double *restrict gm = gam + m0;
             const double er = t->erow[r] + dd, *restrict ec = t->ecol + ca;
@@ -738,7 +829,7 @@ static void tri_block_cyclic(fft_t *t, double lambda, int ra, int rb, int ca, in
                     zi[k] = gm[k] * inv;
                 }
             } else {
-                const double *restrict xm = t->tbuf + t->toff[i - 1] + r * t->trs[i - 1] + ca;
+                const double *restrict xm = blk_row(t, i - 1, r, ca);
                 const double *restrict cm = ci - MODE_BLOCK, *restrict zm = zi - MODE_BLOCK;
                 if (i < n - 1) {
                     for (int k = 0; k < nc; k++) {
@@ -759,10 +850,11 @@ static void tri_block_cyclic(fft_t *t, double lambda, int ra, int rb, int ca, in
         }
     }
     for (int i = n - 2; i >= 0; i--)
-        for (int r = ra; r < rb; r++) {
-            long m0 = (long)(r - ra) * nc;
-            double *restrict xi = t->tbuf + t->toff[i] + r * t->trs[i] + ca;
-            const double *restrict xp = t->tbuf + t->toff[i + 1] + r * t->trs[i + 1] + ca;
+        for (int q = 0; q < B->nr; q++) {
+            int r = B->row[q];
+            long m0 = (long)q * nc;
+            double *restrict xi = blk_row(t, i, r, ca);
+            const double *restrict xp = blk_row(t, i + 1, r, ca);
             const double *restrict ci = cp + (long)i * MODE_BLOCK + m0;
             double *restrict zi = zs + (long)i * MODE_BLOCK + m0;
             const double *restrict zp = zi + MODE_BLOCK;
@@ -772,41 +864,52 @@ static void tri_block_cyclic(fft_t *t, double lambda, int ra, int rb, int ca, in
             }
         }
     /* f = (v·y)/(1 + v·z), kept in gam (overwrites γ after use) */
-    for (int r = ra; r < rb; r++) {
-        long m0 = (long)(r - ra) * nc;
-        const double *x0 = t->tbuf + t->toff[0] + r * t->trs[0] + ca;
-        const double *xn = t->tbuf + t->toff[n - 1] + r * t->trs[n - 1] + ca;
+    for (int q = 0; q < B->nr; q++) {
+        int r = B->row[q];
+        long m0 = (long)q * nc;
+        const double *x0 = blk_row(t, 0, r, ca), *xn = blk_row(t, n - 1, r, ca);
         const double *z0 = zs + m0, *zn = zs + (long)(n - 1) * MODE_BLOCK + m0;
         double *gm = gam + m0;
         for (int k = 0; k < nc; k++) {
-            double q = a0 / gm[k];
-            gm[k] = (x0[k] + q * xn[k]) / (1.0 + z0[k] + q * zn[k]);
+            double qq = a0 / gm[k];
+            gm[k] = (x0[k] + qq * xn[k]) / (1.0 + z0[k] + qq * zn[k]);
         }
     }
-    for (int i = 0; i < n; i++)
-        for (int r = ra; r < rb; r++) {
-            long m0 = (long)(r - ra) * nc;
-            double *restrict xi = t->tbuf + t->toff[i] + r * t->trs[i] + ca;
+    for (int i = 0; i < n; i++) {
+        for (int q = 0; q < B->nr; q++) {
+            long m0 = (long)q * nc;
+            double *restrict xi = blk_row(t, i, B->row[q], ca);
             const double *restrict zi = zs + (long)i * MODE_BLOCK + m0, *restrict gm = gam + m0;
             for (int k = 0; k < nc; k++) xi[k] -= gm[k] * zi[k];
         }
+        blk_butterfly(t, B, i, 1);
+    }
 }
 
-/* A singular mode (eigenvalue 0, λ = 0), column c of row 0.  Its x system
- * has the constant null vector and the left null vector w (wx): first project
- * the right-hand side onto the compatible space (Σ w_i B_i = 0; in physical
- * space this removes the weighted mean of b, as poisson_solve does for other
- * back-ends), then solve rows 0..n−2 with X_{n−1} = 0 (its coupling terms drop:
- * a plain Thomas solve; the last equation holds by compatibility), and shift
- * the result to Σ w_i X_i = 0 (x of zero weighted mean). */
-static void solve_zero_mode(fft_t *t, int c, double *d)
+static void run_block(fft_t *t, double lambda, const block_t *B)
+{
+    if (t->periodic_x)
+        tri_block_cyclic(t, lambda, B);
+    else
+        tri_block(t, lambda, B);
+}
+
+/* A singular mode (eigenvalue 0, λ = 0) with values d (over x).  Its x
+ * system has the constant null vector and the left null vector w (wx):
+ * first project the right-hand side onto the compatible space (Σ w_i B_i =
+ * 0; in physical space this removes the weighted mean of b, as poisson_solve
+ * does for other back-ends), then solve rows 0..n−2 with X_{n−1} = 0 (its
+ * coupling terms drop: a plain Thomas solve; the last equation holds by
+ * compatibility), and shift the result to Σ w_i X_i = 0 (x of zero weighted
+ * mean). */
+static void solve_zero_mode(fft_t *t, double *d)
 {
     const poisson_t *p = t->p;
     int n = t->nx;
     double *cq = t->cp, *w = t->wx;
     double sw = 0.0, swd = 0.0;
     for (int i = 0; i < n; i++) {
-        d[i] = t->scale * t->tbuf[t->toff[i] + c];
+        d[i] *= t->scale;
         sw += w[i];
         swd += w[i] * d[i];
     }
@@ -826,26 +929,66 @@ static void solve_zero_mode(fft_t *t, int c, double *d)
 
 static void tridiagonal_solves(fft_t *t, double lambda)
 {
-    /* singular modes first, into zero_sol (the block solves below leave
-     * meaningless values in their columns, replaced afterwards) */
-    int nzero = lambda == 0.0 ? t->nzero : 0;
-    for (int z = 0; z < nzero; z++) solve_zero_mode(t, t->zcol[z], t->zero_sol + (long)z * t->nx);
-    int nc = t->tcols < MODE_BLOCK ? t->tcols : MODE_BLOCK;
-    int nr = MODE_BLOCK / nc;
-    for (int ra = 0; ra < t->trows; ra += nr) {
-        int rb = ra + nr < t->trows ? ra + nr : t->trows;
-        for (int ca = 0; ca < t->tcols; ca += nc) {
-            int cb = ca + nc < t->tcols ? ca + nc : t->tcols;
-            /* several rows per block only when a row is shorter than a block
-             * (then nc = tcols and each row is whole) */
-            if (t->periodic_x)
-                tri_block_cyclic(t, lambda, ra, rb, ca, cb);
-            else
-                tri_block(t, lambda, ra, rb, ca, cb);
+    int nx = t->nx, nzero = lambda == 0.0 ? t->nzero : 0;
+    double *zsol = t->zero_sol;
+    /* singular modes first, into zero_sol (the block solves leave
+     * meaningless values in their columns, replaced afterwards).  With the
+     * fused butterfly the stored values are before the butterfly: it maps
+     * the pair of columns 0, 1 of row 0 to itself. */
+    if (nzero) {
+        for (int z = 0; z < nzero; z++)
+            for (int i = 0; i < nx; i++) zsol[(long)z * nx + i] = t->tbuf[t->toff[i] + t->zcol[z]];
+        double pair[2];
+        if (t->fused)
+            for (int i = 0; i < nx; i++) {
+                pair[0] = zsol[i];
+                pair[1] = zsol[nx + i];
+                bf_apply(t, pair, NULL, 1, 0, 0, 0);
+                zsol[i] = pair[0];
+                zsol[nx + i] = pair[1];
+            }
+        for (int z = 0; z < nzero; z++) solve_zero_mode(t, zsol + (long)z * nx);
+        if (t->fused)
+            for (int i = 0; i < nx; i++) {
+                pair[0] = zsol[i];
+                pair[1] = zsol[nx + i];
+                bf_apply(t, pair, NULL, 1, 0, 0, 1);
+                zsol[i] = pair[0];
+                zsol[nx + i] = pair[1];
+            }
+    }
+    block_t B = {t->rowlist, 0, 0, 0, 0, 0};
+    if (t->fused) {
+        /* row pairs (k1, N1−k1) × column chunks of even width */
+        int N1 = t->TR, w = t->tcols < MODE_BLOCK / 2 ? t->tcols : MODE_BLOCK / 2;
+        B.bf = 1;
+        for (int k1 = 0; k1 <= N1 / 2; k1++) {
+            int k1p = k1 ? N1 - k1 : 0;
+            t->rowlist[0] = k1;
+            t->rowlist[1] = k1p;
+            B.nr = k1p == k1 ? 1 : 2;
+            B.k1 = k1;
+            for (B.ca = 0; B.ca < t->tcols; B.ca += w) {
+                B.cb = B.ca + w < t->tcols ? B.ca + w : t->tcols;
+                run_block(t, lambda, &B);
+            }
+        }
+    } else {
+        /* several rows per block only when a row is shorter than a block
+         * (then the block holds whole rows) */
+        int nc = t->tcols < MODE_BLOCK ? t->tcols : MODE_BLOCK;
+        int nr = MODE_BLOCK / nc;
+        for (int ra = 0; ra < t->trows; ra += nr) {
+            B.nr = ra + nr < t->trows ? nr : t->trows - ra;
+            for (int q = 0; q < B.nr; q++) t->rowlist[q] = ra + q;
+            for (B.ca = 0; B.ca < t->tcols; B.ca += nc) {
+                B.cb = B.ca + nc < t->tcols ? B.ca + nc : t->tcols;
+                run_block(t, lambda, &B);
+            }
         }
     }
     for (int z = 0; z < nzero; z++)
-        for (int i = 0; i < t->nx; i++) t->tbuf[t->toff[i] + t->zcol[z]] = t->zero_sol[(long)z * t->nx + i];
+        for (int i = 0; i < nx; i++) t->tbuf[t->toff[i] + t->zcol[z]] = zsol[(long)z * nx + i];
 }
 
 static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, double *x)
@@ -853,11 +996,10 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
     fft_t *t = impl;
     const grid_t *g = p->g;
     long o = G_IDX(g, 0, 0, 0);
-    int reord = t->ynn || t->znn;
     if (t->nxu > 0) {
-        if (reord) reorder(t, (double *)b + o, 0);
+        if (t->reord) z_chunks(t, (double *)b + o, 0);
         for (int k = 0; k < t->nsteps; k++) step_run(t, &t->fwd[k], (double *)b + o);
-        if (reord) fast_butterfly(t, 0);
+        if (t->reord && !t->fused) fast_butterfly(t, 0);
     }
     if (t->P > 1)
         MPI_Alltoallv(t->work, t->scount, t->sdispl, MPI_DOUBLE, t->recv, t->rcount, t->rdispl, MPI_DOUBLE,
@@ -867,9 +1009,9 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
         MPI_Alltoallv(t->recv, t->rcount, t->rdispl, MPI_DOUBLE, t->work, t->scount, t->sdispl, MPI_DOUBLE,
                       g->comm);
     if (t->nxu > 0) {
-        if (reord) fast_butterfly(t, 1);
+        if (t->reord && !t->fused) fast_butterfly(t, 1);
         for (int k = 0; k < t->nsteps; k++) step_run(t, &t->inv[k], x + o);
-        if (reord) reorder(t, x + o, 1);
+        if (t->reord) z_chunks(t, x + o, 1);
     }
     /* boundary values of Dirichlet faces (not unknowns) are zero */
     int nz = g->n[2];
@@ -905,8 +1047,13 @@ static void fft_destroy(void *impl)
     free(t->sdispl);
     free(t->rcount);
     free(t->rdispl);
+    for (int k = 0; k < 2; k++) {
+        if (t->zcf[k]) fftw_destroy_plan(t->zcf[k]);
+        if (t->zci[k]) fftw_destroy_plan(t->zci[k]);
+    }
+    free(t->zbuf);
+    free(t->rowlist);
     free(t->work);
-    if (t->aux != t->recv) free(t->aux);
     free(t->recv);
     free(t->wy);
     free(t->wz);
