@@ -14,6 +14,8 @@
  * best FFTW can do); ratios are given to both.  With P ranks the solve is
  * distributed and its ratio to the serial pair includes the parallel
  * speed-up.  Peak RSS is per rank, before the reference transforms run.
+ * The solves run with the default planner (FFTW_ESTIMATE, bit-reproducible)
+ * and with [poisson] fftw_planner = measure.
  */
 #include <fftw3.h>
 #include <math.h>
@@ -69,7 +71,7 @@ static times_t best_pair_time(int n, unsigned flags, int reps)
     return best;
 }
 
-static times_t best_solve_time(int n, bc_type_t wall, int reps)
+static times_t best_solve_time(int n, bc_type_t wall, int measure, int reps)
 {
     int nn[3] = {n, n, n};
     double L[3] = {1, 1, 1};
@@ -77,7 +79,10 @@ static times_t best_solve_time(int n, bc_type_t wall, int reps)
     memset(&bc, 0, sizeof bc);
     for (int d = 0; d < 3; d++) bc.type[d][0] = bc.type[d][1] = wall;
     grid_t *g = grid_create(GEOM_3D, nn, L, NULL, &bc, STRETCH_UNIFORM, 0, MPI_COMM_WORLD);
-    poisson_t *p = poisson_create(g, VAR_P, NULL);
+    poisson_opts_t o = {.method = POISSON_FFT, .fftw_measure = measure};
+    double tp = wtime();
+    poisson_t *p = poisson_create(g, VAR_P, &o);
+    tp = wtime() - tp;
     double *b = field_alloc(g), *x = field_alloc(g);
     for (int i = 0; i < g->nxl; i++)
         for (int j = 0; j < n; j++)
@@ -93,7 +98,8 @@ static times_t best_solve_time(int n, bc_type_t wall, int reps)
         keep_best(&best, w0, c0, g->comm);
     }
     double res = poisson_residual(p, 0.0, b, x);
-    msg("  %s: relative residual %.2e\n", wall == BC_PERIODIC ? "periodic" : "walls", res);
+    msg("  %s, %s planner: relative residual %.2e, set-up %.2f s\n", wall == BC_PERIODIC ? "periodic" : "walls",
+        measure ? "measure" : "estimate", res, tp);
     free(b);
     free(x);
     poisson_free(p);
@@ -112,10 +118,10 @@ int main(int argc, char **argv)
         return 1;
     }
     msg("bench_poisson: %d^3 cells, %d rank(s), best of %d (wall / cpu seconds)\n", n, P, reps);
-    const char *names[2] = {"periodic", "walls"};
+    const char *names[4] = {"periodic", "walls", "periodic, measure planner", "walls, measure planner"};
     bc_type_t walls[2] = {BC_PERIODIC, BC_NOSLIP};
-    times_t t[2];
-    for (int c = 0; c < 2; c++) t[c] = best_solve_time(n, walls[c], reps);
+    times_t t[4];
+    for (int c = 0; c < 4; c++) t[c] = best_solve_time(n, walls[c % 2], c / 2, reps);
     /* peak memory of the solves (before the reference transforms allocate) */
     double rss = (double)peak_rss_bytes(), rmax;
     MPI_Allreduce(&rss, &rmax, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
@@ -124,19 +130,27 @@ int main(int argc, char **argv)
         pe = best_pair_time(n, FFTW_ESTIMATE, reps);
         pm = best_pair_time(n, FFTW_MEASURE, reps);
     }
+    /* the other ranks wait without spinning (a busy-polling MPI call would
+     * take a core from rank 0 on a machine with no spare core) */
+    MPI_Request rq;
+    MPI_Ibarrier(MPI_COMM_WORLD, &rq);
+    for (int done = 0; !done;) {
+        MPI_Test(&rq, &done, MPI_STATUS_IGNORE);
+        if (!done) nanosleep(&(struct timespec){0, 1000000}, NULL);
+    }
     MPI_Bcast(&pe, 2, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     MPI_Bcast(&pm, 2, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     msg("  FFTW r2c+c2r pair (serial, whole grid): ESTIMATE %.4f / %.4f, MEASURE %.4f / %.4f\n", pe.wall, pe.cpu,
         pm.wall, pm.cpu);
     double cells = (double)n * n * n;
-    for (int c = 0; c < 2; c++) {
-        msg("  %-8s solve %.4f / %.4f (%.1f ns per cell wall); ratio to the pair ESTIMATE %.2f / %.2f, "
+    for (int c = 0; c < 4; c++) {
+        msg("  %s: solve %.4f / %.4f (%.1f ns per cell wall); ratio to the pair ESTIMATE %.2f / %.2f, "
             "MEASURE %.2f / %.2f\n",
             names[c], t[c].wall, t[c].cpu, 1e9 * t[c].wall / cells, t[c].wall / pe.wall, t[c].cpu / pe.cpu,
             t[c].wall / pm.wall, t[c].cpu / pm.cpu);
         msg("RESULT bench_poisson np=%d n=%d case=%s solve_wall=%.5f solve_cpu=%.5f pair_est_wall=%.5f "
             "pair_est_cpu=%.5f pair_meas_wall=%.5f pair_meas_cpu=%.5f\n",
-            P, n, names[c], t[c].wall, t[c].cpu, pe.wall, pe.cpu, pm.wall, pm.cpu);
+            P, n, c % 2 ? (c / 2 ? "walls_measure" : "walls") : (c / 2 ? "periodic_measure" : "periodic"), t[c].wall, t[c].cpu, pe.wall, pe.cpu, pm.wall, pm.cpu);
     }
     msg("  peak RSS of the solves (max over ranks) %.1f MB = %.0f bytes per local cell\n", rmax / 1048576.0,
         rmax / (cells / P));

@@ -38,6 +38,7 @@ typedef struct {
     double mg_tol;     /* multigrid: relative residual tolerance */
     int mg_max_cycles; /* multigrid: maximum V-cycles */
     int mg_pre, mg_post; /* multigrid: smoothing sweeps */
+    int fftw_measure;    /* fft: plan with FFTW_MEASURE (faster, not bit-reproducible run to run) */
 } poisson_opts_t;
 
 typedef struct poisson poisson_t;

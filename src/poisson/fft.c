@@ -53,9 +53,10 @@
  * transforms write x.  Uneven splits of the rows are allowed.  With one rank
  * the transforms write [i][y row][z slot] and nothing is exchanged.
  *
- * Plans are made once, with FFTW_ESTIMATE so that the same input gives
- * bit-identical results run after run (FFTW_MEASURE may choose a different
- * algorithm each run).
+ * Plans are made once, with FFTW_ESTIMATE by default so that the same input
+ * gives bit-identical results run after run; [poisson] fftw_planner =
+ * measure uses FFTW_MEASURE (faster transforms, but the algorithm it picks,
+ * hence the round-off, may change from run to run).
  */
 #include <fftw3.h>
 #include <math.h>
@@ -571,7 +572,7 @@ static void *fft_create(poisson_t *p)
         t->dz.eig = xcalloc(1, sizeof(double));
     }
     if (t->dy.m != t->ny || t->dz.m != t->nz) die("poisson fft: unknown counts disagree with the transforms");
-    t->plan_flags = FFTW_ESTIMATE;
+    t->plan_flags = p->opt.fftw_measure ? FFTW_MEASURE : FFTW_ESTIMATE;
     int nx = t->nx, ny = t->ny, nz = t->nz;
     t->fast = t->dim3 && (t->dy.periodic || (t->dy.neumann && ny % 2 == 0)) &&
               (t->dz.periodic || (t->dz.neumann && nz % 2 == 0));
