@@ -114,11 +114,10 @@ typedef struct {
     int fast, ynn, znn, reord; /* reord = ynn || znn */
     int fused;                 /* butterflies applied inside the tridiagonal sweeps (one rank) */
     double *wy, *wz;           /* twiddles e^{−iπk/2N} (re, im) */
-    /* reordering fast path: the z transforms run on chunks of zc rows
-     * gathered (reordered) into zbuf, small enough to stay in cache */
-    int zc;
-    double *zbuf;
-    fftw_plan zcf[2], zci[2];  /* r2c / c2r of a full chunk [0] and of the remainder [1] */
+    /* reordering fast path: the 2-D transforms run plane by plane on a
+     * reordered copy of the plane (pbuf, in cache) */
+    double *pbuf;
+    fftw_plan pfwd, pinv;
 
     /* decomposition of the rows among ranks (P > 1) */
     int P, me;
@@ -260,9 +259,8 @@ static void step_run(fft_t *t, step_t *s, double *f)
 }
 
 /* The transform pipeline.
- * Fast path: one 2-D r2c over (y, z) per x plane when both are periodic;
- * with a Neumann direction, the z r2c of reordered row chunks (z_chunks)
- * then a complex DFT along y in place.
+ * Fast path: one 2-D r2c over (y, z) for all x planes when both are
+ * periodic; with a Neumann direction, plane by plane (plane_transforms).
  * General 3-D: z first (field → work; r2c when z is periodic, so its output
  * is complex and the y step is a complex DFT if y is periodic too, else the
  * r2r kind of z), then y in place (r2r kind of y, on every double).  2-D: y
@@ -281,11 +279,7 @@ static void setup_steps(fft_t *t)
         t->inv[0] = step_make(TK_C2R, 0, 0, SIDE_WORK, SIDE_FIELD, 2, iod(ny, RS / 2, sy), iod(nz, 1, 1), 1,
                               iod(nxu, PS / 2, sx), none);
     } else if (t->fast) {
-        /* z: r2c of reordered chunks (z_chunks); y: complex DFT in place */
-        t->nsteps = 1;
-        fftw_iodim d = iod(ny, RS / 2, RS / 2), h0 = iod(nxu, PS / 2, PS / 2), h1 = iod(TC / 2, 1, 1);
-        t->fwd[0] = step_make(TK_C2C, 0, FFTW_FORWARD, SIDE_WORK, SIDE_WORK, 1, d, none, 2, h0, h1);
-        t->inv[0] = step_make(TK_C2C, 0, FFTW_BACKWARD, SIDE_WORK, SIDE_WORK, 1, d, none, 2, h0, h1);
+        t->nsteps = 0; /* plane_transforms */
     } else if (t->dim3) {
         t->nsteps = 2;
         if (t->dz.periodic) {
@@ -324,56 +318,50 @@ static void setup_steps(fft_t *t)
     }
 }
 
-/* z transforms of the reordering fast path, in chunks of zc rows of a plane.
- * Forward: gather the rows reordered (Makhoul: v(n) = x(2n), v(N−1−n) =
- * x(2n+1) in each Neumann direction; row n1 of the output comes from field
- * row p_y(n1)) into zbuf, which stays in cache, then r2c into the work rows.
- * Inverse: c2r of the work rows into zbuf, scattered back.  This costs no
- * extra pass over memory compared with a transform from the field. */
-static void z_chunks(fft_t *t, double *f, int inverse)
+/* Transforms of the reordering fast path, one x plane at a time.  Forward:
+ * gather the plane reordered (Makhoul: v(n) = x(2n), v(N−1−n) = x(2n+1) in
+ * each Neumann direction; row n1 comes from field row p_y(n1)) into pbuf,
+ * which stays in cache, then one 2-D r2c into the work plane.  Inverse: c2r
+ * of the work plane into pbuf, scattered back.  This costs no extra pass
+ * over memory compared with a transform from the field. */
+static void plane_transforms(fft_t *t, double *f, int inverse)
 {
     const grid_t *g = t->p->g;
     int ny = t->ny, nz = t->nz, hz = nz / 2;
     long o = G_IDX(g, 0, 0, 0);
-    for (int i = 0; i < t->nxu; i++)
-        for (int r0 = 0; r0 < ny; r0 += t->zc) {
-            int cnt = r0 + t->zc <= ny ? t->zc : ny - r0, pl = cnt == t->zc ? 0 : 1;
-            fftw_complex *w = (fftw_complex *)(t->work + i * t->PS + r0 * t->RS);
-            if (inverse) fftw_execute_dft_c2r(t->zci[pl], w, t->zbuf);
-            for (int r = 0; r < cnt; r++) {
-                int n1 = r0 + r, j = !t->ynn ? n1 : n1 < ny / 2 ? 2 * n1 : 2 * (ny - 1 - n1) + 1;
-                double *restrict fr = f + G_IDX(g, i, j, 0) - o;
-                double *restrict zr = t->zbuf + (long)r * nz;
-                if (!t->znn) {
-                    if (inverse)
-                        memcpy(fr, zr, (size_t)nz * sizeof(double));
-                    else
-                        memcpy(zr, fr, (size_t)nz * sizeof(double));
-                } else if (inverse) {
-                    for (int m = 0; m < hz; m++) fr[2 * m] = zr[m];
-                    for (int m = 0; m < hz; m++) fr[2 * m + 1] = zr[nz - 1 - m];
-                } else {
-                    for (int m = 0; m < hz; m++) zr[m] = fr[2 * m];
-                    for (int m = 0; m < hz; m++) zr[nz - 1 - m] = fr[2 * m + 1];
-                }
+    for (int i = 0; i < t->nxu; i++) {
+        fftw_complex *w = (fftw_complex *)(t->work + i * t->PS);
+        if (inverse) fftw_execute_dft_c2r(t->pinv, w, t->pbuf);
+        for (int n1 = 0; n1 < ny; n1++) {
+            int j = !t->ynn ? n1 : n1 < ny / 2 ? 2 * n1 : 2 * (ny - 1 - n1) + 1;
+            double *restrict fr = f + G_IDX(g, i, j, 0) - o;
+            double *restrict zr = t->pbuf + (long)n1 * nz;
+            if (!t->znn) {
+                if (inverse)
+                    memcpy(fr, zr, (size_t)nz * sizeof(double));
+                else
+                    memcpy(zr, fr, (size_t)nz * sizeof(double));
+            } else if (inverse) {
+                for (int m = 0; m < hz; m++) fr[2 * m] = zr[m];
+                for (int m = 0; m < hz; m++) fr[2 * m + 1] = zr[nz - 1 - m];
+            } else {
+                for (int m = 0; m < hz; m++) zr[m] = fr[2 * m];
+                for (int m = 0; m < hz; m++) zr[nz - 1 - m] = fr[2 * m + 1];
             }
-            if (!inverse) fftw_execute_dft_r2c(t->zcf[pl], t->zbuf, w);
         }
+        if (!inverse) fftw_execute_dft_r2c(t->pfwd, t->pbuf, w);
+    }
 }
 
-static void z_chunk_plans(fft_t *t)
+static void plane_plans(fft_t *t)
 {
-    int nz = t->nz, rem = t->ny % t->zc;
-    for (int pl = 0; pl < 2; pl++) {
-        int cnt = pl ? rem : t->zc;
-        if (cnt == 0) continue;
-        fftw_iodim d = iod(nz, 1, 1), hf = iod(cnt, nz, t->RS / 2), hi = iod(cnt, t->RS / 2, nz);
-        t->zcf[pl] = fftw_plan_guru_dft_r2c(1, &d, 1, &hf, t->zbuf, (fftw_complex *)t->work,
-                                            t->plan_flags | FFTW_DESTROY_INPUT);
-        t->zci[pl] = fftw_plan_guru_dft_c2r(1, &d, 1, &hi, (fftw_complex *)t->work, t->zbuf,
-                                            t->plan_flags | FFTW_DESTROY_INPUT);
-        if (!t->zcf[pl] || !t->zci[pl]) die("poisson fft: FFTW could not plan a transform");
-    }
+    int ny = t->ny, nz = t->nz;
+    fftw_iodim df[2] = {iod(ny, nz, t->RS / 2), iod(nz, 1, 1)}, di[2] = {iod(ny, t->RS / 2, nz), iod(nz, 1, 1)};
+    t->pfwd = fftw_plan_guru_dft_r2c(2, df, 0, NULL, t->pbuf, (fftw_complex *)t->work,
+                                     t->plan_flags | FFTW_DESTROY_INPUT);
+    t->pinv = fftw_plan_guru_dft_c2r(2, di, 0, NULL, (fftw_complex *)t->work, t->pbuf,
+                                     t->plan_flags | FFTW_DESTROY_INPUT);
+    if (!t->pfwd || !t->pinv) die("poisson fft: FFTW could not plan a transform");
 }
 
 /* The pass that turns the 2-D DFT V of the reordered data into the cosine
@@ -714,11 +702,8 @@ static void *fft_create(poisson_t *p)
         die("poisson fft: unexpected singular modes");
     if (t->nxu > 0) {
         if (t->reord) {
-            /* chunks of about 8192 doubles (64 KB: in cache) */
-            t->zc = 8192 / nz > 0 ? 8192 / nz : 1;
-            if (t->zc > ny) t->zc = ny;
-            t->zbuf = xcalloc((size_t)t->zc * nz, sizeof(double));
-            z_chunk_plans(t);
+            t->pbuf = xcalloc((size_t)ny * nz, sizeof(double));
+            plane_plans(t);
         }
         setup_steps(t);
         /* plans for the alignment class of fields from field_alloc */
@@ -998,7 +983,7 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
     const grid_t *g = p->g;
     long o = G_IDX(g, 0, 0, 0);
     if (t->nxu > 0) {
-        if (t->reord) z_chunks(t, (double *)b + o, 0);
+        if (t->reord) plane_transforms(t, (double *)b + o, 0);
         for (int k = 0; k < t->nsteps; k++) step_run(t, &t->fwd[k], (double *)b + o);
         if (t->reord && !t->fused) fast_butterfly(t, 0);
     }
@@ -1012,7 +997,7 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
     if (t->nxu > 0) {
         if (t->reord && !t->fused) fast_butterfly(t, 1);
         for (int k = 0; k < t->nsteps; k++) step_run(t, &t->inv[k], x + o);
-        if (t->reord) z_chunks(t, x + o, 1);
+        if (t->reord) plane_transforms(t, x + o, 1);
     }
     /* boundary values of Dirichlet faces (not unknowns) are zero */
     int nz = g->n[2];
@@ -1048,11 +1033,9 @@ static void fft_destroy(void *impl)
     free(t->sdispl);
     free(t->rcount);
     free(t->rdispl);
-    for (int k = 0; k < 2; k++) {
-        if (t->zcf[k]) fftw_destroy_plan(t->zcf[k]);
-        if (t->zci[k]) fftw_destroy_plan(t->zci[k]);
-    }
-    free(t->zbuf);
+    if (t->pfwd) fftw_destroy_plan(t->pfwd);
+    if (t->pinv) fftw_destroy_plan(t->pinv);
+    free(t->pbuf);
     free(t->rowlist);
     free(t->work);
     free(t->recv);
