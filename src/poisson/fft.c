@@ -68,7 +68,7 @@
 
 /* Modes per block of the tridiagonal sweep: the block's data, c' and the
  * Sherman–Morrison vector are n_x × MODE_BLOCK doubles each (in cache). */
-#define MODE_BLOCK 256
+#define MODE_BLOCK 512
 
 typedef struct {
     int m;                     /* transform length (unknowns) */
@@ -945,8 +945,10 @@ static void tridiagonal_solves(fft_t *t, double lambda)
     }
     block_t B = {t->rowlist, 0, 0, 0, 0, 0};
     if (t->fused) {
-        /* row pairs (k1, N1−k1) × column chunks of even width */
-        int N1 = t->TR, w = t->tcols < MODE_BLOCK / 2 ? t->tcols : MODE_BLOCK / 2;
+        /* row pairs (k1, N1−k1) × column chunks of equal even width */
+        int N1 = t->TR, nchunk = (t->tcols + MODE_BLOCK / 2 - 1) / (MODE_BLOCK / 2);
+        int w = (t->tcols + nchunk - 1) / nchunk;
+        w += w % 2;
         B.bf = 1;
         for (int k1 = 0; k1 <= N1 / 2; k1++) {
             int k1p = k1 ? N1 - k1 : 0;
@@ -962,8 +964,8 @@ static void tridiagonal_solves(fft_t *t, double lambda)
     } else {
         /* several rows per block only when a row is shorter than a block
          * (then the block holds whole rows) */
-        int nc = t->tcols < MODE_BLOCK ? t->tcols : MODE_BLOCK;
-        int nr = MODE_BLOCK / nc;
+        int nchunk = (t->tcols + MODE_BLOCK - 1) / MODE_BLOCK;
+        int nc = (t->tcols + nchunk - 1) / nchunk, nr = MODE_BLOCK / nc;
         for (int ra = 0; ra < t->trows; ra += nr) {
             B.nr = ra + nr < t->trows ? nr : t->trows - ra;
             for (int q = 0; q < B.nr; q++) t->rowlist[q] = ra + q;
