@@ -22,7 +22,7 @@
 
 /* Relative residual bound.  A direct solve is backward stable: the residual
  * is about c·ε·‖A‖‖x‖/‖b‖ ≤ c·ε·κ(A), c a modest factor from the O(log n)
- * transform stages.  On the convergence grids (≤ 32 cells per direction,
+ * transform stages.  On the convergence grids (≤ 48 cells per direction,
  * tanh-stretched x with β = 1.5, smallest Δx ≈ L/100) κ(A) ≈ (4/Δx²_min)/π²
  * ≲ 5e3, i.e. ≲ 1e-12; measured: ≤ 1e-13.  The most anisotropic special
  * grid (Δz = 0.7/1024, Δx = 1/8) reaches 9e-13.  1e-11 leaves a factor 10
