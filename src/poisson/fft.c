@@ -379,16 +379,33 @@ static void plane_plans(fft_t *t)
  * only.  The formulas follow from DCT_k = W^k V_k + W^{−k} V_{N−k} applied
  * in each direction and V(−k1, −k2) = conj V(k1, k2) for real data.  Each
  * case is a branch-free loop over k2 (vectorised). */
+/* a = αP and b = conj(αQ) for α = (ar, ai), entry k of rows p and q */
+static inline void bf_twiddle(const double *p, const double *q, int k, double ar, double ai, double *a, double *b)
+{
+    double Pr = p[2 * k], Pi = p[2 * k + 1], Qr = q[2 * k], Qi = q[2 * k + 1];
+    a[0] = ar * Pr - ai * Pi;
+    a[1] = ar * Pi + ai * Pr;
+    b[0] = ar * Qr - ai * Qi;
+    b[1] = -(ar * Qi + ai * Qr);
+}
+
+/* The inverse: P = conj(α) a into p, Q = conj(α b) into q */
+static inline void bf_untwiddle(double *p, double *q, int k, double ar, double ai, const double *a, const double *b)
+{
+    p[2 * k] = ar * a[0] + ai * a[1];
+    p[2 * k + 1] = ar * a[1] - ai * a[0];
+    q[2 * k] = ar * b[0] - ai * b[1];
+    q[2 * k + 1] = -(ar * b[1] + ai * b[0]);
+}
+
 static void bf_nn(double *restrict p, double *restrict q, const double *restrict w, int n, double br, double bi,
                   int inverse)
 {
     if (!inverse)
         for (int k = 0; k < n; k++) {
-            double ar = w[2 * k], ai = w[2 * k + 1];
-            double Pr = p[2 * k], Pi = p[2 * k + 1], Qr = q[2 * k], Qi = q[2 * k + 1];
-            double a_r = ar * Pr - ai * Pi, a_i = ar * Pi + ai * Pr;
-            double b_r = ar * Qr - ai * Qi, b_i = -(ar * Qi + ai * Qr);
-            double Sr = a_r + b_r, Si = a_i + b_i, Dr = a_r - b_r, Di = a_i - b_i;
+            double a[2], b[2];
+            bf_twiddle(p, q, k, w[2 * k], w[2 * k + 1], a, b);
+            double Sr = a[0] + b[0], Si = a[1] + b[1], Dr = a[0] - b[0], Di = a[1] - b[1];
             p[2 * k] = 2.0 * (br * Sr - bi * Si);
             p[2 * k + 1] = -2.0 * (br * Di + bi * Dr);
             q[2 * k] = -2.0 * (br * Si + bi * Sr);
@@ -399,11 +416,8 @@ static void bf_nn(double *restrict p, double *restrict q, const double *restrict
             double ar = w[2 * k], ai = w[2 * k + 1];
             double sr = 0.5 * p[2 * k], di = -0.5 * p[2 * k + 1], si = -0.5 * q[2 * k], dr = -0.5 * q[2 * k + 1];
             double Sr = br * sr + bi * si, Si = br * si - bi * sr, Dr = br * dr + bi * di, Di = br * di - bi * dr;
-            double a_r = 0.5 * (Sr + Dr), a_i = 0.5 * (Si + Di), b_r = 0.5 * (Sr - Dr), b_i = 0.5 * (Si - Di);
-            p[2 * k] = ar * a_r + ai * a_i;
-            p[2 * k + 1] = ar * a_i - ai * a_r;
-            q[2 * k] = ar * b_r - ai * b_i;
-            q[2 * k + 1] = -(ar * b_i + ai * b_r);
+            double a[2] = {0.5 * (Sr + Dr), 0.5 * (Si + Di)}, b[2] = {0.5 * (Sr - Dr), 0.5 * (Si - Di)};
+            bf_untwiddle(p, q, k, ar, ai, a, b);
         }
 }
 
@@ -434,25 +448,19 @@ static void bf_zn(double *restrict p, double *restrict q, const double *restrict
 {
     if (!inverse)
         for (int k = 0; k < n; k++) {
-            double ar = w[2 * k], ai = w[2 * k + 1];
-            double Pr = p[2 * k], Pi = p[2 * k + 1], Qr = q[2 * k], Qi = q[2 * k + 1];
-            double a_r = ar * Pr - ai * Pi, a_i = ar * Pi + ai * Pr;
-            double b_r = ar * Qr - ai * Qi, b_i = -(ar * Qi + ai * Qr);
-            p[2 * k] = a_r + b_r;     /* Re T1 */
-            p[2 * k + 1] = b_i - a_i; /* Re T2 */
-            q[2 * k] = a_i + b_i;     /* Im T1 */
-            q[2 * k + 1] = a_r - b_r; /* Im T2 */
+            double a[2], b[2];
+            bf_twiddle(p, q, k, w[2 * k], w[2 * k + 1], a, b);
+            p[2 * k] = a[0] + b[0];     /* Re T1 */
+            p[2 * k + 1] = b[1] - a[1]; /* Re T2 */
+            q[2 * k] = a[1] + b[1];     /* Im T1 */
+            q[2 * k + 1] = a[0] - b[0]; /* Im T2 */
         }
     else
         for (int k = 0; k < n; k++) {
             double ar = w[2 * k], ai = w[2 * k + 1];
             double T1r = p[2 * k], T2r = p[2 * k + 1], T1i = q[2 * k], T2i = q[2 * k + 1];
-            double a_r = 0.5 * (T1r + T2i), a_i = 0.5 * (T1i - T2r);
-            double b_r = 0.5 * (T1r - T2i), b_i = 0.5 * (T1i + T2r);
-            p[2 * k] = ar * a_r + ai * a_i;
-            p[2 * k + 1] = ar * a_i - ai * a_r;
-            q[2 * k] = ar * b_r - ai * b_i;
-            q[2 * k + 1] = -(ar * b_i + ai * b_r);
+            double a[2] = {0.5 * (T1r + T2i), 0.5 * (T1i - T2r)}, b[2] = {0.5 * (T1r - T2i), 0.5 * (T1i + T2r)};
+            bf_untwiddle(p, q, k, ar, ai, a, b);
         }
 }
 
@@ -913,6 +921,21 @@ static void solve_zero_mode(fft_t *t, double *d)
     for (int i = 0; i < n; i++) d[i] -= swd / sw;
 }
 
+/* The butterfly of row 0 restricted to its columns 0 and 1 (which it maps
+ * to themselves), applied to the singular modes kept in zero_sol. */
+static void zero_pair_butterfly(fft_t *t, int inverse)
+{
+    int nx = t->nx;
+    double *zsol = t->zero_sol, pair[2];
+    for (int i = 0; i < nx; i++) {
+        pair[0] = zsol[i];
+        pair[1] = zsol[nx + i];
+        bf_apply(t, pair, NULL, 1, 0, 0, inverse);
+        zsol[i] = pair[0];
+        zsol[nx + i] = pair[1];
+    }
+}
+
 static void tridiagonal_solves(fft_t *t, double lambda)
 {
     int nx = t->nx, nzero = lambda == 0.0 ? t->nzero : 0;
@@ -924,24 +947,9 @@ static void tridiagonal_solves(fft_t *t, double lambda)
     if (nzero) {
         for (int z = 0; z < nzero; z++)
             for (int i = 0; i < nx; i++) zsol[(long)z * nx + i] = t->tbuf[t->toff[i] + t->zcol[z]];
-        double pair[2];
-        if (t->fused)
-            for (int i = 0; i < nx; i++) {
-                pair[0] = zsol[i];
-                pair[1] = zsol[nx + i];
-                bf_apply(t, pair, NULL, 1, 0, 0, 0);
-                zsol[i] = pair[0];
-                zsol[nx + i] = pair[1];
-            }
+        if (t->fused) zero_pair_butterfly(t, 0);
         for (int z = 0; z < nzero; z++) solve_zero_mode(t, zsol + (long)z * nx);
-        if (t->fused)
-            for (int i = 0; i < nx; i++) {
-                pair[0] = zsol[i];
-                pair[1] = zsol[nx + i];
-                bf_apply(t, pair, NULL, 1, 0, 0, 1);
-                zsol[i] = pair[0];
-                zsol[nx + i] = pair[1];
-            }
+        if (t->fused) zero_pair_butterfly(t, 1);
     }
     block_t B = {t->rowlist, 0, 0, 0, 0, 0};
     if (t->fused) {
