@@ -75,7 +75,10 @@ struct poisson {
      * copy b (otherwise poisson_solve does it around the back-end) */
     int backend_handles_singular;
     /* statistics of the last solve */
-    double last_residual; /* relative residual ||b − A x|| / ||b|| (measured) */
+    double last_residual; /* relative residual ||b − A x|| / ||b|| (measured), or −1 when the
+                           * method does not measure it (the direct solver: round-off by
+                           * construction, measured by its tests; one more operator
+                           * application would cost about 10 % of a solve) */
     int last_iterations;  /* V-cycles (multigrid) or 1 (direct) */
 };
 
