@@ -78,7 +78,7 @@ struct poisson {
     double last_residual; /* relative residual ||b − A x|| / ||b|| (measured), or −1 when the
                            * method does not measure it (the direct solver: round-off by
                            * construction, measured by its tests; one more operator
-                           * application would cost about 10 % of a solve) */
+                           * application costs 15 % of its solve at 128³, measured) */
     int last_iterations;  /* V-cycles (multigrid) or 1 (direct) */
 };
 
