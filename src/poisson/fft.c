@@ -543,6 +543,43 @@ static void fast_butterfly(fft_t *t, int inverse)
         }
 }
 
+/* Scratch shared by every solver object (a run has one per variable
+ * location, and its solves never overlap): the slab-layout array [0] and
+ * the transposed array [1].  A buffer only grows; plans are executed on the
+ * current pointers (FFTW new-array execution: same 64-byte alignment). */
+static struct {
+    double *buf;
+    size_t size;
+    int users;
+} scratch[2];
+
+static void scratch_reserve(int which, size_t n)
+{
+    if (n > scratch[which].size) {
+        free(scratch[which].buf);
+        scratch[which].buf = xcalloc(n, sizeof(double));
+        scratch[which].size = n;
+    }
+    scratch[which].users++;
+}
+
+static void scratch_release(int which)
+{
+    if (--scratch[which].users == 0) {
+        free(scratch[which].buf);
+        scratch[which].buf = NULL;
+        scratch[which].size = 0;
+    }
+}
+
+/* Point the work arrays of t at the shared scratch (call before using them). */
+static void scratch_attach(fft_t *t)
+{
+    t->work = scratch[0].buf;
+    if (t->P > 1) t->recv = scratch[1].buf;
+    t->tbuf = t->P > 1 ? t->recv : t->work;
+}
+
 static void *fft_create(poisson_t *p)
 {
     const grid_t *g = p->g;
@@ -622,8 +659,7 @@ static void *fft_create(poisson_t *p)
         /* work[i][row][col] */
         t->RS = TC;
         t->PS = (long)TR * TC;
-        t->work = xcalloc((size_t)nx * TR * TC, sizeof(double));
-        t->tbuf = t->work;
+        scratch_reserve(0, (size_t)nx * TR * TC);
         for (int i = 0; i < nx; i++) t->toff[i] = (long)i * TR * TC;
         if (t->fused) {
             /* rows and columns: blocks pair row k1 with N1−k1 for the butterfly */
@@ -669,9 +705,8 @@ static void *fft_create(poisson_t *p)
         }
         if ((long)TR * t->nxu * TC > 2147483647L || disp > 2147483647L)
             die("poisson fft: a rank's share exceeds the MPI count range");
-        t->work = xcalloc((size_t)TR * (t->nxu > 0 ? t->nxu : 1) * TC, sizeof(double));
-        t->recv = xcalloc((size_t)(disp > 0 ? disp : 1), sizeof(double));
-        t->tbuf = t->recv;
+        scratch_reserve(0, (size_t)TR * (t->nxu > 0 ? t->nxu : 1) * TC);
+        scratch_reserve(1, (size_t)(disp > 0 ? disp : 1));
         int i = 0;
         for (int s = 0; s < P; s++)
             for (int il = 0; il < t->nxu_r[s]; il++, i++) {
@@ -708,6 +743,7 @@ static void *fft_create(poisson_t *p)
     t->rowlist = xcalloc(MODE_BLOCK, sizeof(int));
     if (t->fused && p->singular && !(t->nzero == 2 && t->zcol[0] == 0 && t->zcol[1] == 1))
         die("poisson fft: unexpected singular modes");
+    scratch_attach(t);
     if (t->nxu > 0) {
         if (t->reord) {
             t->pbuf = xcalloc((size_t)ny * nz, sizeof(double));
@@ -992,6 +1028,7 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
     fft_t *t = impl;
     const grid_t *g = p->g;
     long o = G_IDX(g, 0, 0, 0);
+    scratch_attach(t);
     if (t->nxu > 0) {
         if (t->reord) plane_transforms(t, (double *)b + o, 0);
         for (int k = 0; k < t->nsteps; k++) step_run(t, &t->fwd[k], (double *)b + o);
@@ -1047,8 +1084,8 @@ static void fft_destroy(void *impl)
     if (t->pinv) fftw_destroy_plan(t->pinv);
     free(t->pbuf);
     free(t->rowlist);
-    free(t->work);
-    free(t->recv);
+    scratch_release(0);
+    if (t->P > 1) scratch_release(1);
     free(t->wy);
     free(t->wz);
     free(t->toff);
