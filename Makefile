@@ -20,7 +20,7 @@ BUILD   ?= build
 OPT     := -O3 -march=native -g
 endif
 CFLAGS  := $(STD) $(OPT) $(WARN) -Iinclude $(HDF5_CFLAGS) $(EXTRA_CFLAGS)
-LDLIBS  := $(HDF5_LIBS) -lfftw3 -linih -lgsl -lgslcblas -lm
+LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -linih -lgsl -lgslcblas -lm
 TESTLIBS := -lcmocka
 
 SRC     := $(filter-out src/main.c,$(shell find src -name '*.c' | sort))
@@ -45,7 +45,7 @@ $(LIB): $(OBJ)
 $(BIN): src/main.c $(LIB)
 	$(CC) $(CFLAGS) $< $(LIB) $(LDLIBS) -o $@
 
-$(BUILD)/tests/%: tests/%.c tests/testutil.h $(LIB)
+$(BUILD)/tests/%: tests/%.c $(wildcard tests/*.h) $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -Itests $< $(LIB) $(LDLIBS) $(TESTLIBS) -o $@
 

@@ -34,6 +34,7 @@ typedef struct {
     double cfl;           /* convective CFL of the last step */
     double ke;            /* kinetic energy ½∫|u|² dV (per unit density) */
     double div_max;       /* max |div u| after projection, relative to max|u|/min Δ */
+    double dt;            /* the last time step */
     double res_poisson;   /* relative residual of the last pressure solve */
     int it_poisson;       /* iterations of the last pressure solve */
 } fluid_diag_t;
@@ -52,11 +53,17 @@ struct fluid {
 };
 
 void fluid_register_keys(void);
-/* Read [fluid], [time] and [poisson]; stops with file:line: key: reason. */
+/* Read [fluid] and [poisson] and check them against the grid; stops with
+ * file:line: key: reason.  ([time] and [output] belong to the run driver.) */
 void fluid_params_from_config(cfg_t *cfg, const grid_t *g, fluid_params_t *prm);
 fluid_t *fluid_create(grid_t *g, const fluid_params_t *prm);
-/* Set the initial condition named in [fluid] init (stops on a bad value). */
+/* Set the initial condition named in [fluid] init (stops on a bad value):
+ * rest, taylor_green, abc or laminar (see docs/user-guide.md).  The field is
+ * projected (fluid_project) so that it is discretely divergence-free. */
 void fluid_init_from_config(fluid_t *f, cfg_t *cfg);
+/* Remove the gradient part of u (projection without a pressure update), e.g.
+ * after setting an initial field; fills the ghosts. */
+void fluid_project(fluid_t *f);
 void fluid_free(fluid_t *f);
 
 /* Fill the ghost values of the velocity (walls, axis, periodic, halos). */
@@ -66,7 +73,22 @@ double fluid_stable_dt(const fluid_t *f);
 /* Advance by dt (three RK3 stages, each projected); updates time, step, diag. */
 void fluid_step(fluid_t *f, double dt);
 
+/* ½ Σ |u|² V over the velocity unknowns (per unit density; axisymmetric:
+ * the whole volume, 2π r dr dz). */
 double fluid_kinetic_energy(const fluid_t *f);
+/* max |D u| over the cells (1/s; D is the divergence of the projection). */
 double fluid_max_divergence(const fluid_t *f);
+
+/* The discrete operators, for the tests and for other modules.  u must have
+ * valid ghosts (fluid_apply_bc); each writes the unknowns of out[c] only.
+ *  fluid_advection: ∇·(u⊗u), energy-conserving divergence form;
+ *  fluid_viscous:   ν∇²u including the wall velocities;
+ *  fluid_divergence: D u at the cell centres. */
+void fluid_advection(const fluid_t *f, double *const out[3]);
+void fluid_viscous(const fluid_t *f, double *const out[3]);
+void fluid_divergence(const fluid_t *f, double *div);
+/* Volume of the control cell of the unknown (i,j,k) of component c (local i;
+ * axisymmetric: per radian); the weight of the discrete energy Σ V u². */
+double fluid_cell_volume(const fluid_t *f, int c, int i);
 
 #endif

@@ -86,6 +86,9 @@ void poisson_register_keys(void);
 void poisson_opts_from_config(cfg_t *cfg, poisson_opts_t *o);
 
 poisson_t *poisson_create(const grid_t *g, var_loc_t loc, const poisson_opts_t *opt);
+/* The operator alone, without a solver back-end: poisson_apply and
+ * poisson_fill_ghosts work, poisson_solve does not (explicit viscous term). */
+poisson_t *poisson_create_operator(const grid_t *g, var_loc_t loc);
 void poisson_free(poisson_t *p);
 
 /* Solve (L − λI) x = b.  b and x are fields of the grid (x may equal b);
@@ -105,6 +108,13 @@ void poisson_fill_ghosts(const poisson_t *p, double *x);
 
 /* Is (i,j,k) (local) an unknown of this location? */
 int poisson_is_unknown(const poisson_t *p, int i, int j, int k);
+
+/* Weight of the x unknown ig (global) in the volume-weighted inner product
+ * for which L is symmetric: Σ w (L x) = 0 for every x when L is singular. */
+double poisson_x_weight(const poisson_t *p, int ig);
+/* Weighted mean of the unknowns of f (global), and f += c on the unknowns. */
+double poisson_weighted_mean(const poisson_t *p, const double *f);
+void poisson_add_constant(const poisson_t *p, double *f, double c);
 
 /* Relative residual ||b − (L − λI)x||₂ / ||b||₂ over the unknowns (uses a
  * scratch field; for tests and diagnostics). */

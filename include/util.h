@@ -8,6 +8,9 @@
 
 #define IBMDEM_VERSION "0.1.0"
 
+/* Also send what msg, warn and die print on rank 0 to this file (the run's
+ * log); NULL stops it. */
+void msg_set_log(FILE *f);
 /* Print on rank 0 only (stdout). */
 void msg(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 /* Print on rank 0 to stderr with a "warning: " prefix. */

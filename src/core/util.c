@@ -26,14 +26,32 @@ int mpi_size(void)
     return s;
 }
 
+static FILE *log_file = NULL;
+void msg_set_log(FILE *f) { log_file = f; }
+
+/* Print to `out` and, on rank 0, to the log file. */
+static void print_tee(FILE *out, const char *prefix, const char *fmt, va_list ap)
+{
+    va_list ap2;
+    va_copy(ap2, ap);
+    fputs(prefix, out);
+    vfprintf(out, fmt, ap);
+    fflush(out);
+    if (log_file) {
+        fputs(prefix, log_file);
+        vfprintf(log_file, fmt, ap2);
+        fflush(log_file);
+    }
+    va_end(ap2);
+}
+
 void msg(const char *fmt, ...)
 {
     if (mpi_rank() != 0) return;
     va_list ap;
     va_start(ap, fmt);
-    vfprintf(stdout, fmt, ap);
+    print_tee(stdout, "", fmt, ap);
     va_end(ap);
-    fflush(stdout);
 }
 
 void warn(const char *fmt, ...)
@@ -41,10 +59,8 @@ void warn(const char *fmt, ...)
     if (mpi_rank() != 0) return;
     va_list ap;
     va_start(ap, fmt);
-    fprintf(stderr, "warning: ");
-    vfprintf(stderr, fmt, ap);
+    print_tee(stderr, "warning: ", fmt, ap);
     va_end(ap);
-    fflush(stderr);
 }
 
 void die(const char *fmt, ...)
@@ -52,11 +68,13 @@ void die(const char *fmt, ...)
     if (mpi_rank() == 0) {
         va_list ap;
         va_start(ap, fmt);
-        fprintf(stderr, "error: ");
-        vfprintf(stderr, fmt, ap);
-        fprintf(stderr, "\n");
+        print_tee(stderr, "error: ", fmt, ap);
         va_end(ap);
-        fflush(stderr);
+        fputs("\n", stderr);
+        if (log_file) {
+            fputs("\n", log_file);
+            fflush(log_file);
+        }
     }
     int init = 0, fin = 0;
     MPI_Initialized(&init);

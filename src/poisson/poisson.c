@@ -44,19 +44,11 @@ static ebc_t face_ebc(const grid_t *g, var_loc_t loc, int d, int s)
     return EBC_NEUMANN;                           /* free slip, or a tangential component on the axis */
 }
 
-poisson_t *poisson_create(const grid_t *g, var_loc_t loc, const poisson_opts_t *opt)
+poisson_t *poisson_create_operator(const grid_t *g, var_loc_t loc)
 {
     poisson_t *p = xcalloc(1, sizeof *p);
     p->g = g;
     p->loc = loc;
-    if (opt)
-        p->opt = *opt;
-    else {
-        p->opt.method = POISSON_FFT;
-        p->opt.mg_tol = 1e-10;
-        p->opt.mg_max_cycles = 100;
-        p->opt.mg_pre = p->opt.mg_post = 2;
-    }
     p->singular = 1;
     for (int d = 0; d < 3; d++)
         for (int s = 0; s < 2; s++) {
@@ -111,7 +103,20 @@ poisson_t *poisson_create(const grid_t *g, var_loc_t loc, const poisson_opts_t *
     }
     p->cy = 1.0 / (g->dy * g->dy);
     p->cz = g->dim == 3 ? 1.0 / (g->dz * g->dz) : 0.0;
+    return p;
+}
 
+poisson_t *poisson_create(const grid_t *g, var_loc_t loc, const poisson_opts_t *opt)
+{
+    poisson_t *p = poisson_create_operator(g, loc);
+    if (opt)
+        p->opt = *opt;
+    else {
+        p->opt.method = POISSON_FFT;
+        p->opt.mg_tol = 1e-10;
+        p->opt.mg_max_cycles = 100;
+        p->opt.mg_pre = p->opt.mg_post = 2;
+    }
     p->backend = p->opt.method == POISSON_FFT ? &poisson_backend_fft : &poisson_backend_mg;
     p->impl = p->backend->create(p);
     return p;
@@ -211,7 +216,7 @@ void poisson_apply(poisson_t *p, double lambda, double *x, double *y)
 
 /* Volume weight of unknown i (global) for the compatibility condition of a
  * singular problem: Σ w_i (L x)_i = 0 for every x. */
-static double x_weight(const poisson_t *p, int ig)
+double poisson_x_weight(const poisson_t *p, int ig)
 {
     const grid_t *g = p->g;
     if (p->loc == VAR_U) return g->geom == GEOM_AXI ? g->gxf[ig] * g->gdxc[ig] : g->gdxc[ig];
@@ -219,14 +224,14 @@ static double x_weight(const poisson_t *p, int ig)
 }
 
 /* Weighted mean of the unknowns of f. */
-static double weighted_mean(const poisson_t *p, const double *f)
+double poisson_weighted_mean(const poisson_t *p, const double *f)
 {
     const grid_t *g = p->g;
     double s = 0.0, w = 0.0;
     for (int i = 0; i < g->nxl; i++) {
         int ig = i + g->ix0;
         if (ig >= p->nu[0]) continue;
-        double wi = x_weight(p, ig), si = 0.0;
+        double wi = poisson_x_weight(p, ig), si = 0.0;
         for (int j = 0; j < p->nu[1]; j++)
             for (int k = 0; k < p->nu[2]; k++) si += f[G_IDX(g, i, j, k)];
         s += wi * si;
@@ -237,7 +242,7 @@ static double weighted_mean(const poisson_t *p, const double *f)
     return r[0] / r[1];
 }
 
-static void add_constant(const poisson_t *p, double *f, double c)
+void poisson_add_constant(const poisson_t *p, double *f, double c)
 {
     const grid_t *g = p->g;
     for (int i = 0; i < g->nxl; i++) {
@@ -249,19 +254,20 @@ static void add_constant(const poisson_t *p, double *f, double c)
 
 int poisson_solve(poisson_t *p, double lambda, const double *b, double *x)
 {
+    if (!p->backend) die("poisson_solve: operator created without a solver (poisson_create_operator)");
     const double *rhs = b;
     double *tmp = NULL;
     int sing = p->singular && lambda == 0.0 && !p->backend_handles_singular;
     if (sing) {
         /* Remove the incompatible part (weighted mean) of b. */
-        double m = weighted_mean(p, b);
+        double m = poisson_weighted_mean(p, b);
         tmp = field_alloc(p->g);
         field_copy(p->g, tmp, b);
-        add_constant(p, tmp, -m);
+        poisson_add_constant(p, tmp, -m);
         rhs = tmp;
     }
     int rc = p->backend->solve(p, p->impl, lambda, rhs, x);
-    if (sing) add_constant(p, x, -weighted_mean(p, x));
+    if (sing) poisson_add_constant(p, x, -poisson_weighted_mean(p, x));
     free(tmp);
     return rc;
 }
@@ -272,7 +278,7 @@ double poisson_residual(poisson_t *p, double lambda, const double *b, double *x)
     double *y = field_alloc(g);
     double *bb = field_alloc(g);
     field_copy(g, bb, b);
-    if (p->singular && lambda == 0.0) add_constant(p, bb, -weighted_mean(p, b));
+    if (p->singular && lambda == 0.0) poisson_add_constant(p, bb, -poisson_weighted_mean(p, b));
     poisson_apply(p, lambda, x, y);
     double rr = 0.0, bn = 0.0;
     for (int i = 0; i < g->nxl; i++)

@@ -1,0 +1,196 @@
+/* io.h — everything a run writes or reads besides the case file.
+ *
+ * One job per file in src/io/:
+ *   outdir.c      the output folder, its log file and the resolved input
+ *   series.c      the time series of diagnostics (CSV, one row per output step)
+ *   h5.c          parallel HDF5: grid fields as x-slab hyperslabs, attributes
+ *   snapshot.c    field snapshots (one HDF5 file each) and the XDMF index for ParaView
+ *   checkpoint.c  checkpoint files (atomic write, header, pruning) and the input fingerprint
+ *   summary.c     summary.json, the machine-readable results of a run
+ *   progress.c    the progress line on a terminal
+ *
+ * Every function is collective over the grid's communicator unless it says
+ * "rank 0": then only rank 0 does the work and the other ranks return at once.
+ */
+#ifndef IBMDEM_IO_H
+#define IBMDEM_IO_H
+
+#include <hdf5.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "config.h"
+#include "grid.h"
+
+#define IO_PATH_MAX 4096
+
+/* ---- output folder (outdir.c) --------------------------------------------- */
+
+typedef struct {
+    char dir[IO_PATH_MAX];
+    FILE *log; /* rank 0: DIR/log.txt */
+} io_outdir_t;
+
+/* Create DIR and its parents, open DIR/log.txt (appended to when `append`,
+ * e.g. on a restart) and send to it everything rank 0 prints with msg, warn
+ * and die.  Stops the run (every rank) if DIR cannot be created. */
+void io_outdir_open(io_outdir_t *o, const char *dir, int append, MPI_Comm comm);
+/* "DIR/name" into buf. */
+void io_outdir_path(const io_outdir_t *o, const char *name, char *buf, size_t n);
+/* Rank 0: DIR/input.ini = the resolved input (cfg_write_resolved). */
+void io_outdir_write_input(const io_outdir_t *o, const cfg_t *cfg);
+void io_outdir_close(io_outdir_t *o);
+
+/* ---- time series (series.c) ---------------------------------------------- */
+
+typedef struct io_series io_series_t;
+
+/* Rank 0 writes PATH, a CSV file with a header line of the `ncol` column
+ * names; column 0 must be "step".  restart_step < 0: a new file.  Otherwise
+ * the rows of an existing PATH with step <= restart_step are kept (a run
+ * restarted from a checkpoint continues the series without duplicates). */
+io_series_t *io_series_open(const char *path, int ncol, const char *const *names, long restart_step);
+/* Rank 0: one row of ncol values (integers are written without decimals). */
+void io_series_row(io_series_t *s, const double *values);
+void io_series_close(io_series_t *s);
+
+/* ---- parallel HDF5 (h5.c) -------------------------------------------------- */
+
+/* Create (truncate) / open read-only an HDF5 file with the MPI-IO driver.
+ * io_h5_create stops the run on failure; io_h5_open returns a negative id. */
+hid_t io_h5_create(const char *path, MPI_Comm comm);
+hid_t io_h5_open(const char *path, MPI_Comm comm);
+void io_h5_close(hid_t file);
+
+/* The interior of a grid field (i = 0..nx-1, j = 0..ny-1, k = 0..nz-1, no
+ * ghosts) as dataset `name` of shape [nx][ny][nz] — the memory order, k
+ * fastest — every rank writing its x-slab collectively.  The values are
+ * copied bit for bit: this is the checkpoint layout.  For a face variable,
+ * index i is the face on the high side of cell i (grid.h). */
+void io_h5_write_field(hid_t loc, const char *name, const grid_t *g, const double *f);
+/* Read such a dataset into the interior of f (ghosts untouched).  Returns 0,
+ * or -1 (on every rank) if it is missing or its shape is not the grid's. */
+int io_h5_read_field(hid_t loc, const char *name, const grid_t *g, double *f);
+
+/* A cell quantity of ncomp components given on each rank's slab as
+ * buf[((k*ny + j)*nxl + i)*ncomp + c], written as dataset [nz][ny][nx] (or
+ * [nz][ny][nx][ncomp]): x fastest, the order XDMF and ParaView expect. */
+void io_h5_write_cells_xfast(hid_t loc, const char *name, const grid_t *g, int ncomp, const double *buf);
+
+/* Small arrays and attributes: every rank passes the same values. */
+void io_h5_write_array(hid_t loc, const char *name, long n, const double *v);
+/* Returns the length read (<= nmax), or -1 if missing. */
+long io_h5_read_array(hid_t loc, const char *name, long nmax, double *v);
+void io_h5_write_text(hid_t loc, const char *name, const char *text);
+char *io_h5_read_text(hid_t loc, const char *name); /* malloc'd; NULL if missing */
+void io_h5_attr_double(hid_t loc, const char *name, double v);
+void io_h5_attr_long(hid_t loc, const char *name, long v);
+void io_h5_attr_string(hid_t loc, const char *name, const char *v);
+/* Return 0, or -1 if the attribute is missing. */
+int io_h5_get_attr_double(hid_t loc, const char *name, double *v);
+int io_h5_get_attr_long(hid_t loc, const char *name, long *v);
+
+/* ---- field snapshots + XDMF (snapshot.c) ------------------------------------- */
+
+typedef struct io_snapshots io_snapshots_t;
+
+/* Snapshots of grid `g` into DIR/fields_NNNNN.h5, indexed by DIR/fields.xmf.
+ * `first` is the index of the next snapshot (0 for a new run; a restart
+ * passes the count stored in the checkpoint, and the entries of fields.xmf
+ * before it are kept). */
+io_snapshots_t *io_snapshots_create(const grid_t *g, const char *dir, int first);
+/* Start the next snapshot: creates its file with the mesh (cell faces x, y, z;
+ * a 2-D grid is written as one cell in z, of the smallest in-plane width). */
+void io_snapshot_begin(io_snapshots_t *s, double time, long step);
+/* A cell-centred scalar grid field. */
+void io_snapshot_cell_scalar(io_snapshots_t *s, const char *name, const double *f);
+/* A staggered vector (u[d] on the faces normal to d; u[2] may be NULL in 2-D),
+ * interpolated to the cell centres: the average of the two faces of the cell,
+ * which is linear interpolation since a centre is midway between its faces.
+ * The ghost faces must be valid (boundary conditions applied). */
+void io_snapshot_face_vector(io_snapshots_t *s, const char *name, double *const u[3]);
+/* Close the file and rewrite DIR/fields.xmf (rank 0), so the index is valid
+ * whenever the run stops. */
+void io_snapshot_end(io_snapshots_t *s);
+int io_snapshots_count(const io_snapshots_t *s);
+void io_snapshots_free(io_snapshots_t *s);
+
+/* ---- checkpoints (checkpoint.c) ---------------------------------------------- */
+
+#define IO_CHECKPOINT_FORMAT 1
+
+typedef struct {
+    double time;
+    long step;
+    uint64_t fingerprint; /* io_input_fingerprint of the resolved input */
+    int nranks;           /* rank count of the run that wrote it (exactness needs the same) */
+    char *input;          /* the resolved input text (malloc'd by io_checkpoint_open) */
+} io_checkpoint_header_t;
+
+/* Start DIR/checkpoint_SSSSSSSS.h5 (S = step): written to a temporary name
+ * and renamed by io_checkpoint_end, so a run killed while writing leaves the
+ * previous checkpoint intact.  The header goes in root attributes. */
+hid_t io_checkpoint_begin(const char *dir, const io_checkpoint_header_t *h, MPI_Comm comm);
+/* Close, rename; path of the final file into `path` (may be NULL); rank 0
+ * then deletes the oldest checkpoint_*.h5 of DIR beyond the `keep` newest
+ * (keep <= 0: keep all). */
+void io_checkpoint_end(hid_t file, const char *dir, long step, int keep, char *path, size_t npath, MPI_Comm comm);
+/* Open a checkpoint and read its header.  Returns the file (close with
+ * io_h5_close), or stops the run with a message naming the file if it cannot
+ * be read or is not an ibmdem checkpoint. */
+hid_t io_checkpoint_open(const char *path, io_checkpoint_header_t *h, MPI_Comm comm);
+void io_checkpoint_header_free(io_checkpoint_header_t *h);
+
+/* FNV-1a 64-bit hash of the resolved input (text of cfg_write_resolved),
+ * over its "section.key = value" lines with comments and the origin notes
+ * removed, skipping the keys that `skip` matches (section.key, or section.*
+ * for a whole section): the run-control keys, which a restart may change. */
+uint64_t io_input_fingerprint(const char *resolved, const char *const *skip);
+/* Call fn for every key (section.key) whose value differs between two
+ * resolved inputs (missing on one side counts), except the skipped ones;
+ * returns the number of differences. */
+int io_input_diff(const char *a, const char *b, const char *const *skip,
+                  void (*fn)(const char *key, const char *va, const char *vb, void *ctx), void *ctx);
+/* The resolved input as a string (malloc'd). */
+char *io_resolved_input(const cfg_t *cfg);
+
+/* ---- summary.json (summary.c) --------------------------------------------------- */
+
+typedef struct io_summary io_summary_t;
+
+/* Keys are dotted paths ("fluid.kinetic_energy"); each dot opens a nested
+ * object.  Setting a key again replaces its value; insertion order is kept.
+ * Non-finite numbers are written as null (JSON has no NaN). */
+io_summary_t *io_summary_create(void);
+void io_summary_string(io_summary_t *s, const char *key, const char *v);
+void io_summary_double(io_summary_t *s, const char *key, double v);
+void io_summary_long(io_summary_t *s, const char *key, long v);
+void io_summary_bool(io_summary_t *s, const char *key, int v);
+/* Rank 0: write the JSON object to PATH; returns 0 or -1. */
+int io_summary_write(const io_summary_t *s, const char *path);
+void io_summary_free(io_summary_t *s);
+
+/* ---- progress line (progress.c) -------------------------------------------------- */
+
+typedef struct {
+    int active;        /* rank 0 and stdout is a terminal */
+    double wall0;      /* wall time at the start */
+    double frac0;      /* progress at the start (a restart does not start at 0) */
+    long step0;
+    double last;       /* wall time of the last refresh */
+    int shown;         /* length of the line on screen (0: none) */
+} io_progress_t;
+
+/* The line (simulated time, percent, steps/s, ETA) is redrawn in place with
+ * \r at most every 0.25 s, on rank 0.  mode 0 (auto): only when stdout is a
+ * terminal and the program was not started by mpirun — Open MPI gives its
+ * processes a pseudo-terminal whatever mpirun's own output is, so isatty
+ * cannot tell there; 1: always; 2: never. */
+void io_progress_start(io_progress_t *p, double frac, long step, int mode);
+/* frac = progress in [0, 1] (the largest of the fractions of t_end,
+ * max_steps and wall_limit). */
+void io_progress_update(io_progress_t *p, double time, long step, double frac);
+/* Erase the line (before other output, and at the end). */
+void io_progress_clear(io_progress_t *p);
+
+#endif

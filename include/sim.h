@@ -1,0 +1,136 @@
+/* sim.h — the run driver: reads [time] and [output], builds the parts of the
+ * scene the case file describes, runs the time loop and writes the outputs.
+ *
+ * A run is a set of PARTS (sim_part_t), each a physical model taking part in
+ * the time loop through a few callbacks.  sim.c knows nothing of the physics:
+ * it asks each part for its stable time step, advances each part, collects
+ * its diagnostics and checks, and tells it when to write snapshots and
+ * checkpoints.  The fluid part is src/core/sim_fluid.c; a scene without a
+ * [fluid] section has no fluid part.  A new model (particles/DEM, immersed
+ * boundary coupling, pore network) adds a file src/core/sim_<name>.c with a
+ * function that fills a sim_part_t, and one line in sim_create() (sim.c,
+ * "parts of the scene").  Coupled models (e.g. the DEM sub-cycled inside the
+ * fluid step) install their hooks when their part is created.
+ *
+ * The loop (docs/theory.md §1):
+ *   dt = min over parts of stable_dt      (fluid_stable_dt)
+ *   every part: advance(dt)              (fluid_step)
+ *   diagnostics; stop with a checkpoint if a part reports divergence
+ *   outputs due at this step (series, fields, checkpoint), progress line
+ */
+#ifndef IBMDEM_SIM_H
+#define IBMDEM_SIM_H
+
+#include <hdf5.h>
+
+#include "config.h"
+#include "io.h"
+
+#define SIM_MAX_PARTS 8
+#define SIM_MAX_COLS 64
+
+typedef struct sim sim_t;
+
+typedef struct sim_part {
+    const char *name; /* checkpoint group, summary.json prefix */
+    void *ctx;
+    /* Largest stable time step (INFINITY if the part sets no limit). */
+    double (*stable_dt)(void *ctx);
+    /* Advance by dt from the current state. */
+    void (*advance)(void *ctx, double dt);
+    /* Columns this part adds to the time series, and their values after a
+     * step (called every step: the divergence checks use them). */
+    int ncol;
+    const char *const *col_names;
+    void (*diagnostics)(void *ctx, double *cols);
+    /* After a step: non-zero with a reason if the state is unusable (non-finite
+     * values, a stability limit exceeded, a blow-up). */
+    int (*diverged)(void *ctx, char *why, size_t nwhy);
+    /* Keep / bring back the state at the start of the step (so a diverged
+     * run checkpoints the last good state); NULL if the part cannot. */
+    void (*keep_previous)(void *ctx);
+    void (*restore_previous)(void *ctx);
+    /* Relative rate of change over the last step, per unit time (for
+     * [time] steady_tol); needs keep_previous.  NULL: always steady. */
+    double (*change_rate)(void *ctx, double dt);
+    /* Write a snapshot of the part's fields (its own files in the output folder). */
+    void (*write_fields)(void *ctx, double time, long step);
+    /* Write / read the exact state of the part in an HDF5 group of a checkpoint. */
+    void (*checkpoint_write)(void *ctx, hid_t group);
+    void (*checkpoint_read)(void *ctx, hid_t group, const char *path);
+    /* Final results for summary.json (keys are prefixed with the part's name). */
+    void (*summary)(void *ctx, io_summary_t *s, const char *prefix);
+    void (*destroy)(void *ctx);
+} sim_part_t;
+
+/* Run-control values read from [time] and [output]. */
+typedef struct {
+    double t_end;          /* stop at this simulated time */
+    long max_steps;        /* stop after this step number (0: no limit) */
+    double wall_limit;     /* stop (with a checkpoint) after this many seconds (0: none) */
+    double steady_tol;     /* stop when every part's relative rate of change < this (0: off) */
+    double cfl_abort;      /* hard CFL limit: above it the run has diverged */
+    double ke_growth_abort; /* kinetic energy growing by more than this factor in one step: diverged */
+    int rollback;          /* keep the previous state (checkpoint on divergence, steady test) */
+    char dir[IO_PATH_MAX]; /* output folder */
+    char name[256];        /* case name */
+    double fields_every;   /* simulated time between field snapshots (0: first and last only) */
+    long series_every;     /* steps between rows of the time series */
+    long checkpoint_every; /* steps between checkpoints (0: at the end only) */
+    int checkpoint_keep;   /* checkpoints kept in the folder (0: all) */
+    int progress;          /* progress line: 0 auto, 1 on, 2 off (io_progress_start) */
+} sim_params_t;
+
+typedef enum { SIM_RUNNING = 0, SIM_T_END, SIM_MAX_STEPS, SIM_WALL_LIMIT, SIM_STEADY, SIM_DIVERGED } sim_status_t;
+
+struct sim {
+    cfg_t *cfg;
+    MPI_Comm comm;
+    sim_params_t prm;
+    sim_part_t part[SIM_MAX_PARTS];
+    int npart;
+    /* state */
+    double time, dt;
+    long step;
+    double time_prev;        /* time and step at the start of the last step */
+    long step_prev;
+    double wall0, wall_step; /* start of the run; wall time of the last step */
+    long step0;              /* step at the start of this run (restart) */
+    sim_status_t status;
+    char why[512];           /* why the run diverged */
+    /* outputs */
+    io_outdir_t out;
+    io_series_t *series;
+    io_summary_t *summary;
+    io_progress_t progress;
+    double next_fields;      /* simulated time of the next snapshot */
+    long last_fields_step, last_series_step, last_checkpoint_step;
+    double next_report;      /* progress fraction of the next report line */
+    char last_checkpoint[IO_PATH_MAX + 64];
+    char restart_path[IO_PATH_MAX];
+    char *input;             /* resolved input (text) */
+    uint64_t fingerprint;
+    int check_only;
+};
+
+void sim_register_keys(void);
+
+/* Read [time] and [output], build every part of the scene and its initial
+ * state; with restart != NULL, continue from that checkpoint.  check_only:
+ * validate and build without creating any output (ibmdem check). */
+sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only);
+/* Add a part (called from sim_create). */
+void sim_add_part(sim_t *s, const sim_part_t *part);
+/* Run to the end; returns the exit status: 0 when the run finished (t_end,
+ * max_steps, steady state or wall_limit), 3 when it diverged. */
+int sim_run(sim_t *s);
+void sim_free(sim_t *s);
+
+/* The keys a restart may change without breaking exactness (the fingerprint
+ * skips them): run control and outputs. */
+extern const char *const sim_run_control_keys[];
+
+/* The fluid part (sim_fluid.c): built when the case has a [fluid] section. */
+void sim_add_fluid(sim_t *s, cfg_t *cfg);
+
+#endif

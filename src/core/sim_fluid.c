@@ -1,0 +1,286 @@
+/* sim_fluid.c — the fluid as a part of a run (sim.h): its time step, its
+ * diagnostics and divergence checks, its snapshots (pressure and the
+ * velocity at cell centres) and its exact state in checkpoints. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fluid.h"
+#include "grid.h"
+#include "sim.h"
+#include "util.h"
+
+typedef struct {
+    sim_t *sim;
+    grid_t *g;
+    fluid_t *f;
+    double *prev[4];      /* u, v, w, p at the start of the step (rollback) */
+    double prev_time;
+    long prev_step;
+    double ke_now, ke_prev; /* kinetic energy after and before the last step */
+    double div_init;      /* max |div u| of the initial state */
+    int stepped;          /* a step was taken in this run */
+    io_snapshots_t *snaps;
+    int snap_first;       /* index of the first snapshot of this run */
+} fluid_part_t;
+
+static const char *const fluid_cols[] = {"cfl", "kinetic_energy", "div_max", "poisson_residual",
+                                         "poisson_iterations"};
+
+static int ncomp(const fluid_part_t *fp) { return fp->g->dim == 3 ? 3 : 2; }
+
+static double part_stable_dt(void *ctx) { return fluid_stable_dt(((fluid_part_t *)ctx)->f); }
+
+static void part_advance(void *ctx, double dt)
+{
+    fluid_part_t *fp = ctx;
+    fp->ke_prev = fp->ke_now;
+    fluid_step(fp->f, dt);
+    fp->ke_now = fp->f->diag.ke;
+    fp->stepped = 1;
+}
+
+static void part_diagnostics(void *ctx, double *c)
+{
+    fluid_part_t *fp = ctx;
+    const fluid_diag_t *d = &fp->f->diag;
+    if (!fp->stepped) { /* the initial state (or the one restarted from) */
+        c[0] = 0;
+        c[1] = fp->ke_now;
+        c[2] = fp->div_init;
+        c[3] = 0;
+        c[4] = 0;
+        return;
+    }
+    c[0] = d->cfl;
+    c[1] = fp->ke_now;
+    c[2] = d->div_max;
+    c[3] = d->res_poisson;
+    c[4] = d->it_poisson;
+}
+
+/* A step is unusable when it produced non-finite values (a NaN or Inf in u
+ * makes the kinetic energy non-finite; one in p reaches u and the residual),
+ * when its CFL number is above the hard limit (beyond the stability of RK3
+ * with central advection, |λΔt| ≤ √3, the solution is noise), or when the
+ * kinetic energy jumps by a large factor in one step (an instability). */
+static int part_diverged(void *ctx, char *why, size_t n)
+{
+    fluid_part_t *fp = ctx;
+    const fluid_diag_t *d = &fp->f->diag;
+    const sim_params_t *sp = &fp->sim->prm;
+    if (!isfinite(fp->ke_now) || !isfinite(d->div_max) || !isfinite(d->res_poisson) || !isfinite(d->cfl)) {
+        snprintf(why, n, "non-finite values (kinetic energy %g, max |div u| %g, Poisson residual %g)", fp->ke_now,
+                 d->div_max, d->res_poisson);
+        return 1;
+    }
+    double limit = sp->cfl_abort;
+    const char *src = "time.cfl_abort";
+    if (fp->f->prm.dt_fixed <= 0 && 2.0 * fp->f->prm.cfl < limit) {
+        limit = 2.0 * fp->f->prm.cfl;
+        src = "twice the CFL target of the adaptive step";
+    }
+    if (d->cfl > limit) {
+        snprintf(why, n, "CFL = %.4g is above the hard limit %.4g (%s)", d->cfl, limit, src);
+        return 1;
+    }
+    if (fp->ke_prev > 0 && fp->ke_now > sp->ke_growth_abort * fp->ke_prev) {
+        snprintf(why, n, "the kinetic energy grew by a factor %.4g in one step (limit: time.ke_growth_abort = %g)",
+                 fp->ke_now / fp->ke_prev, sp->ke_growth_abort);
+        return 1;
+    }
+    return 0;
+}
+
+static void part_keep_previous(void *ctx)
+{
+    fluid_part_t *fp = ctx;
+    fluid_t *f = fp->f;
+    for (int c = 0; c < 4; c++) {
+        double *src = c < 3 ? f->u[c] : f->p;
+        if (!src) continue;
+        if (!fp->prev[c]) fp->prev[c] = field_alloc(fp->g);
+        field_copy(fp->g, fp->prev[c], src);
+    }
+    fp->prev_time = f->time;
+    fp->prev_step = f->step;
+}
+
+static void part_restore_previous(void *ctx)
+{
+    fluid_part_t *fp = ctx;
+    fluid_t *f = fp->f;
+    for (int c = 0; c < 4; c++) {
+        double *dst = c < 3 ? f->u[c] : f->p;
+        if (dst && fp->prev[c]) field_copy(fp->g, dst, fp->prev[c]);
+    }
+    f->time = fp->prev_time;
+    f->step = fp->prev_step;
+    fp->ke_now = fp->ke_prev;
+}
+
+/* max |u(n+1) − u(n)| / (Δt max |u(n+1)|) over the interior: the relative
+ * rate of change per unit time, which tends to 0 at a steady state. */
+static double part_change_rate(void *ctx, double dt)
+{
+    fluid_part_t *fp = ctx;
+    const grid_t *g = fp->g;
+    double du = 0, umax = 0;
+    for (int c = 0; c < ncomp(fp); c++) {
+        const double *u = fp->f->u[c], *u0 = fp->prev[c];
+        if (!u0) return INFINITY;
+        for (int i = 0; i < g->nxl; i++)
+            for (int j = 0; j < g->n[1]; j++)
+                for (int k = 0; k < g->n[2]; k++) {
+                    long q = G_IDX(g, i, j, k);
+                    du = fmax(du, fabs(u[q] - u0[q]));
+                    umax = fmax(umax, fabs(u[q]));
+                }
+    }
+    du = grid_max(g, du);
+    umax = grid_max(g, umax);
+    return umax > 0 ? du / (dt * umax) : 0.0;
+}
+
+static void part_write_fields(void *ctx, double time, long step)
+{
+    fluid_part_t *fp = ctx;
+    if (!fp->snaps) fp->snaps = io_snapshots_create(fp->g, fp->sim->out.dir, fp->snap_first);
+    fluid_apply_bc(fp->f); /* the ghost faces enter the interpolation to cell centres */
+    io_snapshot_begin(fp->snaps, time, step);
+    io_snapshot_cell_scalar(fp->snaps, "pressure", fp->f->p);
+    io_snapshot_face_vector(fp->snaps, "velocity", fp->f->u);
+    io_snapshot_end(fp->snaps);
+}
+
+static const char *const field_name[4] = {"u", "v", "w", "p"};
+
+static void part_checkpoint_write(void *ctx, hid_t grp)
+{
+    fluid_part_t *fp = ctx;
+    fluid_t *f = fp->f;
+    io_h5_attr_double(grp, "time", f->time);
+    io_h5_attr_long(grp, "step", f->step);
+    io_h5_attr_long(grp, "snapshots", fp->snaps ? io_snapshots_count(fp->snaps) : fp->snap_first);
+    io_h5_attr_string(grp, "layout", "interior of each staggered field, [nx][ny][nz], k fastest; "
+                                     "u(i) on the high x face of cell i (CaNS convention)");
+    for (int c = 0; c < 4; c++) {
+        const double *src = c < 3 ? f->u[c] : f->p;
+        if (c == 2 && fp->g->dim != 3) continue;
+        io_h5_write_field(grp, field_name[c], fp->g, src);
+    }
+}
+
+/* Ghosts of the pressure after a restart: halo exchange, and at a
+ * non-periodic face the zero-gradient (Neumann) image, the boundary
+ * condition of the pressure at walls and at the axis. */
+static void fill_pressure_ghosts(const grid_t *g, double *p)
+{
+    grid_halo(g, p);
+    if (!g->periodic[0]) {
+        for (int j = -1; j <= g->n[1]; j++)
+            for (int k = -g->gz; k < g->n[2] + g->gz; k++) {
+                if (g->left == MPI_PROC_NULL) p[G_IDX(g, -1, j, k)] = p[G_IDX(g, 0, j, k)];
+                if (g->right == MPI_PROC_NULL) p[G_IDX(g, g->nxl, j, k)] = p[G_IDX(g, g->nxl - 1, j, k)];
+            }
+    }
+    if (!g->periodic[1])
+        for (int i = -1; i <= g->nxl; i++)
+            for (int k = -g->gz; k < g->n[2] + g->gz; k++) {
+                p[G_IDX(g, i, -1, k)] = p[G_IDX(g, i, 0, k)];
+                p[G_IDX(g, i, g->n[1], k)] = p[G_IDX(g, i, g->n[1] - 1, k)];
+            }
+    if (g->dim == 3 && !g->periodic[2])
+        for (int i = -1; i <= g->nxl; i++)
+            for (int j = -1; j <= g->n[1]; j++) {
+                p[G_IDX(g, i, j, -1)] = p[G_IDX(g, i, j, 0)];
+                p[G_IDX(g, i, j, g->n[2])] = p[G_IDX(g, i, j, g->n[2] - 1)];
+            }
+}
+
+static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
+{
+    fluid_part_t *fp = ctx;
+    fluid_t *f = fp->f;
+    for (int c = 0; c < 4; c++) {
+        double *dst = c < 3 ? f->u[c] : f->p;
+        if (c == 2 && fp->g->dim != 3) continue;
+        if (io_h5_read_field(grp, field_name[c], fp->g, dst))
+            die("%s: /fluid/%s is missing or is not a %d x %d x %d field: the checkpoint is of another grid", path,
+                field_name[c], fp->g->n[0], fp->g->n[1], fp->g->n[2]);
+    }
+    long snaps = 0;
+    if (io_h5_get_attr_double(grp, "time", &f->time) || io_h5_get_attr_long(grp, "step", &f->step))
+        die("%s: /fluid has no time or step attribute", path);
+    if (io_h5_get_attr_long(grp, "snapshots", &snaps) == 0) fp->snap_first = (int)snaps;
+    fluid_apply_bc(f);
+    fill_pressure_ghosts(fp->g, f->p);
+    fp->ke_now = fluid_kinetic_energy(f);
+    fp->div_init = fluid_max_divergence(f);
+}
+
+static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
+{
+    fluid_part_t *fp = ctx;
+    const fluid_diag_t *d = &fp->f->diag;
+    const grid_t *g = fp->g;
+    char key[128];
+    double umax = 0;
+    for (int c = 0; c < ncomp(fp); c++)
+        for (int i = 0; i < g->nxl; i++)
+            for (int j = 0; j < g->n[1]; j++)
+                for (int k = 0; k < g->n[2]; k++) umax = fmax(umax, fabs(fp->f->u[c][G_IDX(g, i, j, k)]));
+    umax = grid_max(g, umax);
+#define KEY(name) (snprintf(key, sizeof key, "%s.%s", prefix, name), key)
+    io_summary_long(y, KEY("cells"), (long)g->n[0] * g->n[1] * g->n[2]);
+    io_summary_double(y, KEY("kinetic_energy"), fp->ke_now);
+    io_summary_double(y, KEY("max_velocity_component"), umax);
+    io_summary_double(y, KEY("cfl"), d->cfl);
+    io_summary_double(y, KEY("div_max"), fp->stepped ? d->div_max : fp->div_init);
+    io_summary_double(y, KEY("poisson_residual"), d->res_poisson);
+    io_summary_long(y, KEY("poisson_iterations"), d->it_poisson);
+#undef KEY
+}
+
+static void part_destroy(void *ctx)
+{
+    fluid_part_t *fp = ctx;
+    for (int c = 0; c < 4; c++) free(fp->prev[c]);
+    io_snapshots_free(fp->snaps);
+    fluid_free(fp->f);
+    grid_free(fp->g);
+    free(fp);
+}
+
+void sim_add_fluid(sim_t *s, cfg_t *cfg)
+{
+    fluid_part_t *fp = xcalloc(1, sizeof *fp);
+    fp->sim = s;
+    fp->g = grid_create_from_config(cfg, s->comm);
+    fluid_params_t prm;
+    fluid_params_from_config(cfg, fp->g, &prm);
+    fp->f = fluid_create(fp->g, &prm);
+    fluid_init_from_config(fp->f, cfg);
+    fluid_apply_bc(fp->f);
+    fp->ke_now = fluid_kinetic_energy(fp->f);
+    fp->div_init = fluid_max_divergence(fp->f);
+    sim_part_t part = {
+        .name = "fluid",
+        .ctx = fp,
+        .stable_dt = part_stable_dt,
+        .advance = part_advance,
+        .ncol = 5,
+        .col_names = fluid_cols,
+        .diagnostics = part_diagnostics,
+        .diverged = part_diverged,
+        .keep_previous = part_keep_previous,
+        .restore_previous = part_restore_previous,
+        .change_rate = part_change_rate,
+        .write_fields = part_write_fields,
+        .checkpoint_write = part_checkpoint_write,
+        .checkpoint_read = part_checkpoint_read,
+        .summary = part_summary,
+        .destroy = part_destroy,
+    };
+    sim_add_part(s, &part);
+}

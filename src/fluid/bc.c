@@ -1,0 +1,89 @@
+/* bc.c — ghost values of the velocity: periodic images and halos, no-slip
+ * walls with a wall velocity, free-slip walls, the axis of an axisymmetric
+ * grid.
+ *
+ * A component normal to a face has its boundary value ON the face (index −1
+ * at the low side, n−1 at the high side, grid.h): it is 0 at every wall and
+ * on the axis (no penetration; u_r = 0 on the axis).  A tangential component
+ * is cell-centred normal to the face; its ghost mirrors the first interior
+ * value so that the face value (the mean of the two) is the wall's:
+ *   no-slip:            ghost = 2 U_wall − interior   (second order, the
+ *                       value the Laplacian of poisson.c assumes: its
+ *                       homogeneous part ghost = −interior plus 2 U_wall)
+ *   free-slip and axis: ghost = interior               (zero normal gradient;
+ *                       on the axis u_z is even in r)
+ */
+#include "fluid_internal.h"
+
+/* ghost value of a tangential component at a face of type t with wall velocity U */
+static inline double tangential_ghost(bc_type_t t, double U, double interior)
+{
+    return t == BC_NOSLIP ? 2.0 * U - interior : interior;
+}
+
+void fluid_fill_ghosts_component(const fluid_t *f, int c, double *u)
+{
+    const grid_t *g = f->g;
+    const bc_t *bc = &g->bc;
+    int nxl = g->nxl, ny = g->n[1], nz = g->n[2], gz = g->gz;
+    grid_halo(g, u);
+
+    /* x faces: only the ranks that own them */
+    if (!g->periodic[0]) {
+        for (int s = 0; s < 2; s++) {
+            if ((s == 0 && g->left != MPI_PROC_NULL) || (s == 1 && g->right != MPI_PROC_NULL)) continue;
+            bc_type_t t = bc->type[0][s];
+            double U = bc->vel[0][s][c];
+            int ib = s == 0 ? -1 : nxl - 1; /* boundary face of u, or the ghost cell of v, w */
+            for (int j = -1; j <= ny; j++)
+                for (int k = -gz; k < nz + gz; k++) {
+                    if (c == 0) {
+                        u[G_IDX(g, ib, j, k)] = 0.0;
+                        if (s == 1) u[G_IDX(g, nxl, j, k)] = 0.0; /* beyond the wall: unused */
+                    } else {
+                        int ig = s == 0 ? -1 : nxl, ii = s == 0 ? 0 : nxl - 1;
+                        u[G_IDX(g, ig, j, k)] = tangential_ghost(t, U, u[G_IDX(g, ii, j, k)]);
+                    }
+                }
+        }
+    }
+    /* y faces (every rank, ghost planes in x included) */
+    if (!g->periodic[1]) {
+        for (int i = -1; i <= nxl; i++)
+            for (int k = -gz; k < nz + gz; k++) {
+                if (c == 1) {
+                    u[G_IDX(g, i, -1, k)] = 0.0;
+                    u[G_IDX(g, i, ny - 1, k)] = 0.0;
+                    u[G_IDX(g, i, ny, k)] = 0.0;
+                } else {
+                    u[G_IDX(g, i, -1, k)] = tangential_ghost(bc->type[1][0], bc->vel[1][0][c], u[G_IDX(g, i, 0, k)]);
+                    u[G_IDX(g, i, ny, k)] =
+                        tangential_ghost(bc->type[1][1], bc->vel[1][1][c], u[G_IDX(g, i, ny - 1, k)]);
+                }
+            }
+    }
+    /* z faces */
+    if (g->dim == 3 && !g->periodic[2]) {
+        for (int i = -1; i <= nxl; i++)
+            for (int j = -1; j <= ny; j++) {
+                if (c == 2) {
+                    u[G_IDX(g, i, j, -1)] = 0.0;
+                    u[G_IDX(g, i, j, nz - 1)] = 0.0;
+                    u[G_IDX(g, i, j, nz)] = 0.0;
+                } else {
+                    u[G_IDX(g, i, j, -1)] = tangential_ghost(bc->type[2][0], bc->vel[2][0][c], u[G_IDX(g, i, j, 0)]);
+                    u[G_IDX(g, i, j, nz)] =
+                        tangential_ghost(bc->type[2][1], bc->vel[2][1][c], u[G_IDX(g, i, j, nz - 1)]);
+                }
+            }
+    }
+}
+
+void fluid_apply_bc(fluid_t *f)
+{
+    for (int c = 0; c < fluid_ncomp(f->g); c++) fluid_fill_ghosts_component(f, c, f->u[c]);
+}
+
+/* The pressure (and its correction φ) has zero normal gradient at walls and
+ * on the axis: the ghosts of the VAR_P operator. */
+void fluid_fill_pressure_ghosts(const fluid_t *f, double *p) { poisson_fill_ghosts(fluid_priv(f)->pp, p); }

@@ -1,0 +1,78 @@
+/* timestep.c — the time step allowed by the stability of RK3.
+ *
+ * Convective limit: central advection has imaginary eigenvalues bounded by
+ * Σ_d |u_d|/Δ_d; RK3 is stable on the imaginary axis up to √3, so
+ * CFL = Δt · max_cells Σ_d |u_d|/Δ_d ≤ cfl (default 0.5).
+ * Viscous limit (explicit only): the eigenvalues of νL are real, negative and
+ * bounded by ν ρ(L) with ρ(L) ≤ max row sum of |L| (Gershgorin; 4Σ_d 1/Δ_d²
+ * on a uniform grid, the exact spectral radius in the limit); RK3 is stable on
+ * the negative real axis up to 2.51, so Fo = Δt ν ρ(L)/4 ≤ fourier
+ * (default 0.5, stable up to 0.628).
+ */
+#include <float.h>
+#include <math.h>
+
+#include "fluid_internal.h"
+#include "util.h"
+
+double fluid_convective_rate(const fluid_t *f)
+{
+    const grid_t *g = f->g;
+    const double *u = f->u[0], *v = f->u[1], *w = g->dim == 3 ? f->u[2] : NULL;
+    double rdy = 1.0 / g->dy, rdz = g->dim == 3 ? 1.0 / g->dz : 0.0, r = 0.0;
+    for (int i = 0; i < g->nxl; i++) {
+        double rdx = 1.0 / g->dxf[i];
+        for (int j = 0; j < g->n[1]; j++)
+            for (int k = 0; k < g->n[2]; k++) {
+                long m = G_IDX(g, i, j, k);
+                double s = fmax(fabs(u[m]), fabs(u[m - g->sx])) * rdx + fmax(fabs(v[m]), fabs(v[m - g->sy])) * rdy;
+                if (w) s += fmax(fabs(w[m]), fabs(w[m - 1])) * rdz;
+                r = fmax(r, s);
+            }
+    }
+    return grid_max(g, r);
+}
+
+/* ρ(L)/4 bound: max over the velocity locations of the Gershgorin row sum / 4 */
+static double viscous_rate(const fluid_t *f)
+{
+    const grid_t *g = f->g;
+    const fluid_priv_t *q = fluid_priv(f);
+    double r = 0.0;
+    for (int c = 0; c < fluid_ncomp(g); c++) {
+        const poisson_t *p = q->pv[c];
+        double rx = 0.0;
+        for (int i = 0; i < p->nu[0]; i++) rx = fmax(rx, fabs(p->cw[i]) + fabs(p->ce[i]) + fabs(p->cd[i]));
+        r = fmax(r, rx + 4.0 * (p->cy + p->cz));
+    }
+    return 0.25 * r;
+}
+
+double fluid_stable_dt(const fluid_t *f)
+{
+    const fluid_params_t *prm = &f->prm;
+    const grid_t *g = f->g;
+    if (prm->dt_fixed > 0) return prm->dt_fixed;
+    /* Velocity scales that exist before the flow does, so that a fluid at
+     * rest set in motion by a moving wall or a body force does not take a
+     * huge first step: the wall speed, and √(|f| Δ) (a cell crossed after
+     * accelerating from rest for Δt ≈ √(Δ/|f|)). */
+    double dmin = fmin(g->dy, g->dim == 3 ? g->dz : g->dy);
+    for (int i = 0; i < g->n[0]; i++) dmin = fmin(dmin, g->gdxf[i]);
+    double uw = 0.0, fb = 0.0;
+    for (int d = 0; d < 3; d++) {
+        fb = fmax(fb, fabs(prm->body_force[d]));
+        for (int s = 0; s < 2; s++)
+            for (int c = 0; c < 3; c++) uw = fmax(uw, fabs(g->bc.vel[d][s][c]));
+    }
+    double rate = fmax(fluid_convective_rate(f), fmax(uw / dmin, sqrt(fb / dmin)));
+    double dt = rate > 0 ? prm->cfl / rate : DBL_MAX;
+    double dt_visc = prm->nu > 0 ? prm->fourier / (prm->nu * viscous_rate(f)) : DBL_MAX;
+    if (!prm->implicit_viscous) dt = fmin(dt, dt_visc);
+    if (prm->dt_max > 0) dt = fmin(dt, prm->dt_max);
+    /* implicit, at rest, unforced and without dt_max: nothing limits the step;
+     * take the explicit viscous one */
+    if (dt == DBL_MAX) dt = dt_visc;
+    if (dt == DBL_MAX) die("fluid_stable_dt: nothing limits the time step (inviscid fluid at rest): set dt or dt_max");
+    return dt;
+}

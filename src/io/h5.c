@@ -1,0 +1,242 @@
+/* h5.c — parallel HDF5 helpers.  Grid fields are split in x-slabs, one per
+ * rank, and each rank writes or reads its slab as a hyperslab of one global
+ * dataset with collective MPI-IO, so the files do not depend on the rank
+ * count that wrote them.  Small data (arrays, text, attributes) is passed
+ * identically by every rank; rank 0's copy is written. */
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "io.h"
+#include "util.h"
+
+static hid_t fapl_mpio(MPI_Comm comm)
+{
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    H5Pset_fapl_mpio(fapl, comm, MPI_INFO_NULL);
+    /* metadata reads and writes collective: fewer small requests */
+    H5Pset_all_coll_metadata_ops(fapl, 1);
+    H5Pset_coll_metadata_write(fapl, 1);
+    return fapl;
+}
+
+hid_t io_h5_create(const char *path, MPI_Comm comm)
+{
+    hid_t fapl = fapl_mpio(comm);
+    hid_t f = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    H5Pclose(fapl);
+    if (f < 0) die("cannot create the HDF5 file %s", path);
+    return f;
+}
+
+hid_t io_h5_open(const char *path, MPI_Comm comm)
+{
+    /* Decide on rank 0 whether the file can be opened, so that no rank is
+     * left waiting in a collective open that another one skipped. */
+    int rank, ok = 0;
+    MPI_Comm_rank(comm, &rank);
+    if (rank == 0) {
+        H5E_BEGIN_TRY { ok = access(path, R_OK) == 0 && H5Fis_hdf5(path) > 0; }
+        H5E_END_TRY;
+    }
+    MPI_Bcast(&ok, 1, MPI_INT, 0, comm);
+    if (!ok) return -1;
+    hid_t fapl = fapl_mpio(comm);
+    hid_t f;
+    H5E_BEGIN_TRY { f = H5Fopen(path, H5F_ACC_RDONLY, fapl); }
+    H5E_END_TRY;
+    H5Pclose(fapl);
+    return f;
+}
+
+void io_h5_close(hid_t file)
+{
+    if (file >= 0) H5Fclose(file);
+}
+
+static hid_t dxpl_collective(void)
+{
+    hid_t x = H5Pcreate(H5P_DATASET_XFER);
+    H5Pset_dxpl_mpio(x, H5FD_MPIO_COLLECTIVE);
+    return x;
+}
+
+/* Memory space of a whole field with its ghosts, the interior selected. */
+static hid_t field_memspace(const grid_t *g)
+{
+    hsize_t dims[3] = {(hsize_t)g->nxl + 2, (hsize_t)g->n[1] + 2, (hsize_t)g->n[2] + 2 * g->gz};
+    hsize_t start[3] = {1, 1, (hsize_t)g->gz}, count[3] = {(hsize_t)g->nxl, (hsize_t)g->n[1], (hsize_t)g->n[2]};
+    hid_t m = H5Screate_simple(3, dims, NULL);
+    H5Sselect_hyperslab(m, H5S_SELECT_SET, start, NULL, count, NULL);
+    return m;
+}
+
+/* File space [nx][ny][nz], this rank's slab selected. */
+static hid_t field_filespace(const grid_t *g)
+{
+    hsize_t dims[3] = {(hsize_t)g->n[0], (hsize_t)g->n[1], (hsize_t)g->n[2]};
+    hsize_t start[3] = {(hsize_t)g->ix0, 0, 0}, count[3] = {(hsize_t)g->nxl, (hsize_t)g->n[1], (hsize_t)g->n[2]};
+    hid_t s = H5Screate_simple(3, dims, NULL);
+    H5Sselect_hyperslab(s, H5S_SELECT_SET, start, NULL, count, NULL);
+    return s;
+}
+
+void io_h5_write_field(hid_t loc, const char *name, const grid_t *g, const double *f)
+{
+    hid_t fs = field_filespace(g), ms = field_memspace(g), x = dxpl_collective();
+    hid_t d = H5Dcreate2(loc, name, H5T_NATIVE_DOUBLE, fs, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (d < 0 || H5Dwrite(d, H5T_NATIVE_DOUBLE, ms, fs, x, f) < 0) die("HDF5: cannot write the field %s", name);
+    H5Dclose(d);
+    H5Pclose(x);
+    H5Sclose(ms);
+    H5Sclose(fs);
+}
+
+int io_h5_read_field(hid_t loc, const char *name, const grid_t *g, double *f)
+{
+    if (H5Lexists(loc, name, H5P_DEFAULT) <= 0) return -1;
+    hid_t d = H5Dopen2(loc, name, H5P_DEFAULT);
+    if (d < 0) return -1;
+    hid_t s = H5Dget_space(d);
+    hsize_t dims[3] = {0, 0, 0};
+    int rank = H5Sget_simple_extent_ndims(s);
+    if (rank == 3) H5Sget_simple_extent_dims(s, dims, NULL);
+    H5Sclose(s);
+    if (rank != 3 || dims[0] != (hsize_t)g->n[0] || dims[1] != (hsize_t)g->n[1] || dims[2] != (hsize_t)g->n[2]) {
+        H5Dclose(d);
+        return -1;
+    }
+    hid_t fs = field_filespace(g), ms = field_memspace(g), x = dxpl_collective();
+    herr_t r = H5Dread(d, H5T_NATIVE_DOUBLE, ms, fs, x, f);
+    H5Pclose(x);
+    H5Sclose(ms);
+    H5Sclose(fs);
+    H5Dclose(d);
+    return r < 0 ? -1 : 0;
+}
+
+void io_h5_write_cells_xfast(hid_t loc, const char *name, const grid_t *g, int ncomp, const double *buf)
+{
+    int rank = ncomp > 1 ? 4 : 3;
+    hsize_t dims[4] = {(hsize_t)g->n[2], (hsize_t)g->n[1], (hsize_t)g->n[0], (hsize_t)ncomp};
+    hsize_t start[4] = {0, 0, (hsize_t)g->ix0, 0};
+    hsize_t count[4] = {(hsize_t)g->n[2], (hsize_t)g->n[1], (hsize_t)g->nxl, (hsize_t)ncomp};
+    hid_t fs = H5Screate_simple(rank, dims, NULL);
+    H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, count, NULL);
+    hid_t ms = H5Screate_simple(rank, count, NULL);
+    hid_t x = dxpl_collective();
+    hid_t d = H5Dcreate2(loc, name, H5T_NATIVE_DOUBLE, fs, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (d < 0 || H5Dwrite(d, H5T_NATIVE_DOUBLE, ms, fs, x, buf) < 0) die("HDF5: cannot write %s", name);
+    H5Dclose(d);
+    H5Pclose(x);
+    H5Sclose(ms);
+    H5Sclose(fs);
+}
+
+/* Write `data` of type t and shape fs on rank 0 only (collectively: the other
+ * ranks select nothing). */
+static void write_rank0(hid_t loc, const char *name, hid_t t, hid_t fs, const void *data)
+{
+    hid_t d = H5Dcreate2(loc, name, t, fs, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (d < 0) die("HDF5: cannot create %s", name);
+    hid_t ms = H5Scopy(fs), fsel = H5Scopy(fs), x = dxpl_collective();
+    if (mpi_rank() != 0) {
+        H5Sselect_none(ms);
+        H5Sselect_none(fsel);
+    }
+    if (H5Dwrite(d, t, ms, fsel, x, data) < 0) die("HDF5: cannot write %s", name);
+    H5Pclose(x);
+    H5Sclose(fsel);
+    H5Sclose(ms);
+    H5Dclose(d);
+}
+
+void io_h5_write_array(hid_t loc, const char *name, long n, const double *v)
+{
+    hsize_t dim = (hsize_t)n;
+    hid_t fs = H5Screate_simple(1, &dim, NULL);
+    write_rank0(loc, name, H5T_NATIVE_DOUBLE, fs, v);
+    H5Sclose(fs);
+}
+
+long io_h5_read_array(hid_t loc, const char *name, long nmax, double *v)
+{
+    if (H5Lexists(loc, name, H5P_DEFAULT) <= 0) return -1;
+    hid_t d = H5Dopen2(loc, name, H5P_DEFAULT);
+    hid_t s = H5Dget_space(d);
+    hssize_t n = H5Sget_simple_extent_npoints(s);
+    H5Sclose(s);
+    if (n < 0 || n > nmax) {
+        H5Dclose(d);
+        return -1;
+    }
+    herr_t r = H5Dread(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, v);
+    H5Dclose(d);
+    return r < 0 ? -1 : (long)n;
+}
+
+static hid_t string_type(size_t len)
+{
+    hid_t t = H5Tcopy(H5T_C_S1);
+    H5Tset_size(t, len ? len : 1);
+    H5Tset_strpad(t, H5T_STR_NULLTERM);
+    return t;
+}
+
+void io_h5_write_text(hid_t loc, const char *name, const char *text)
+{
+    hid_t t = string_type(strlen(text) + 1), s = H5Screate(H5S_SCALAR);
+    write_rank0(loc, name, t, s, text);
+    H5Sclose(s);
+    H5Tclose(t);
+}
+
+char *io_h5_read_text(hid_t loc, const char *name)
+{
+    if (H5Lexists(loc, name, H5P_DEFAULT) <= 0) return NULL;
+    hid_t d = H5Dopen2(loc, name, H5P_DEFAULT);
+    hid_t ft = H5Dget_type(d);
+    size_t len = H5Tget_size(ft);
+    H5Tclose(ft);
+    char *text = calloc(len + 1, 1);
+    hid_t t = string_type(len);
+    if (H5Dread(d, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, text) < 0) {
+        free(text);
+        text = NULL;
+    }
+    H5Tclose(t);
+    H5Dclose(d);
+    return text;
+}
+
+static void attr_write(hid_t loc, const char *name, hid_t t, const void *v)
+{
+    if (H5Aexists(loc, name) > 0) H5Adelete(loc, name);
+    hid_t s = H5Screate(H5S_SCALAR);
+    hid_t a = H5Acreate2(loc, name, t, s, H5P_DEFAULT, H5P_DEFAULT);
+    if (a < 0 || H5Awrite(a, t, v) < 0) die("HDF5: cannot write the attribute %s", name);
+    H5Aclose(a);
+    H5Sclose(s);
+}
+
+void io_h5_attr_double(hid_t loc, const char *name, double v) { attr_write(loc, name, H5T_NATIVE_DOUBLE, &v); }
+void io_h5_attr_long(hid_t loc, const char *name, long v) { attr_write(loc, name, H5T_NATIVE_LONG, &v); }
+
+void io_h5_attr_string(hid_t loc, const char *name, const char *v)
+{
+    hid_t t = string_type(strlen(v) + 1);
+    attr_write(loc, name, t, v);
+    H5Tclose(t);
+}
+
+static int attr_read(hid_t loc, const char *name, hid_t t, void *v)
+{
+    if (H5Aexists(loc, name) <= 0) return -1;
+    hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
+    herr_t r = H5Aread(a, t, v);
+    H5Aclose(a);
+    return r < 0 ? -1 : 0;
+}
+
+int io_h5_get_attr_double(hid_t loc, const char *name, double *v) { return attr_read(loc, name, H5T_NATIVE_DOUBLE, v); }
+int io_h5_get_attr_long(hid_t loc, const char *name, long *v) { return attr_read(loc, name, H5T_NATIVE_LONG, v); }

@@ -1,0 +1,109 @@
+#!/bin/bash
+# bad_input_test.sh — every kind of bad input stops the run before it starts
+# with the exit status 2 and a message `file:line: section.key: reason`
+# (no line when the key is absent or given by --set); a diverging run stops
+# with status 3, a message and a checkpoint that --restart accepts.
+# Prints TAP lines (ok N - ... / not ok N - ...).
+. "$(dirname "$0")/tap.sh"
+T=$(mktemp -d /tmp/ibmdem_bad_input.XXXXXX)
+
+# The base case: a small lid-driven cavity.  Line numbers matter below.
+base() {
+cat <<'INI'
+[domain]
+geometry = 2d
+nx = 8
+ny = 8
+length = 1 1 1
+[boundary]
+x_lo = noslip
+x_hi = noslip
+y_lo = noslip
+y_hi = noslip
+y_hi_velocity = 1 0 0
+[fluid]
+nu = 0.01
+[time]
+t_end = 0.1
+INI
+}
+# line numbers of the base case:  nx 3, x_lo 7, x_hi 8, nu 13, [time] 14
+
+# check NAME STATUS REGEX -- COMMAND...: run, then assert status and stderr
+check() {
+    local name=$1 want=$2 regex=$3; shift 4
+    "$@" >"$T/out" 2>"$T/err"
+    local rc=$?
+    if [ "$rc" = "$want" ] && { [ -z "$regex" ] || grep -Eq -- "$regex" "$T/err"; }; then
+        report 0 "$name"
+    else
+        report 1 "$name (status $rc, want $want; stderr below, want /$regex/)"
+        sed 's/^/#   /' "$T/err" | head -5
+    fi
+}
+
+# edit the base case: sed expression -> $T/NAME.ini
+mk() { base | sed "$2" >"$T/$1.ini"; echo "$T/$1.ini"; }
+
+f=$(mk ok 's/^//')
+check "the base case is valid" 0 "" -- $BIN check "$f"
+
+f=$(mk unknown_key 's/^nu = 0.01$/nuu = 0.01/')
+check "unknown key" 2 "^$f:13: fluid.nuu: unknown key$" -- $BIN check "$f"
+
+f=$(mk unknown_section 's/^\[time\]$/[times]/')
+check "unknown section" 2 "^$f:15: \[times\]: unknown section$" -- $BIN check "$f"
+
+f=$(mk missing_key '/^ny = /d')
+check "missing required key" 2 "^$f: domain.ny: missing key" -- $BIN check "$f"
+
+f=$(mk wrong_type 's/^nx = 8$/nx = eight/')
+check "wrong type" 2 "^$f:3: domain.nx: 'eight' is not an integer$" -- $BIN check "$f"
+
+f=$(mk out_of_range 's/^nu = 0.01$/nu = 0.01\ncfl = 5/')
+check "out-of-range value" 2 "^$f:14: fluid.cfl: 5 is out of range \[1e-06, 1.7\]$" -- $BIN check "$f"
+
+f=$(mk periodic_one_face '/^x_hi = /d')
+check "periodic on one face only" 2 "^$f:7: boundary.x_lo: periodic on one x face only" -- $BIN check "$f"
+
+f=$(mk negative_viscosity 's/^nu = 0.01$/nu = -0.01/')
+check "negative viscosity" 2 "^$f:13: fluid.nu: -0.01 is out of range" -- $BIN check "$f"
+
+f=$(mk odd_nx 's/^nx = 8$/nx = 9/')
+check "grid not dividing among 2 ranks (mpirun -np 2, nx = 9)" 2 \
+    "^$f:3: domain.nx: 9 cells do not divide among 2 ranks" -- $MPIRUN -np 2 $BIN check "$f"
+
+f=$(mk syntax 's/^\[fluid\]$/[fluid]\nthis line is not ini/')
+check "syntax error" 2 "^$f:13: syntax error" -- $BIN check "$f"
+
+f=$T/ok.ini
+check "bad --set (no section.key=value)" 2 "^--set nu: expected section.key=value$" -- $BIN check "$f" --set nu
+check "bad --set (wrong type)" 2 "^--set fluid.nu: 'abc' is not a real number$" -- $BIN check "$f" --set fluid.nu=abc
+check "bad --set (unknown key)" 2 "^--set fluid.mu: unknown key$" -- $BIN check "$f" --set fluid.mu=1
+
+check "unreadable file" 2 "^$T/nope.ini: cannot open: No such file or directory$" -- $BIN check "$T/nope.ini"
+cp "$f" "$T/noperm.ini"; chmod 000 "$T/noperm.ini"
+if [ "$(id -u)" != 0 ]; then
+    check "unreadable file (no permission)" 2 "^$T/noperm.ini: cannot open: Permission denied$" -- $BIN check "$T/noperm.ini"
+fi
+check "unknown option" 2 "unknown option '--frobnicate'" -- $BIN run "$f" --frobnicate
+check "restart from a file that is not a checkpoint" 1 "$f: cannot open the checkpoint" -- \
+    $BIN run "$f" --out "$T/o1" --restart "$f"
+
+# A diverging run: a fixed time step 16 times the convective limit of the lid
+# (CFL = U dt / dx = 1 x 0.5 x 8 = 4 at the first step, above the hard limit
+# 1.5) must stop with status 3 and a checkpoint of the state it started from.
+out=$T/diverge
+check "a diverging run stops with a message" 3 \
+    "^error: the run diverged at step 1 .*CFL = [0-9.]+ is above the hard limit 1.5 \(time.cfl_abort\)" -- \
+    $BIN run "$f" --set fluid.dt=0.5 --set time.t_end=10 --out "$out"
+[ -f "$out/checkpoint_00000000.h5" ] && grep -q "is saved in $out/checkpoint_00000000.h5" "$T/err" &&
+    $PY -c "import json,sys; d=json.load(open('$out/summary.json')); sys.exit(d['status']!='diverged')"
+report $? "the diverged run left checkpoint_00000000.h5 and summary.json status = diverged"
+check "--restart accepts that checkpoint (with a stable dt)" 0 "fluid.dt: 0.5 in the checkpoint, 0.01 now" -- \
+    $BIN run "$f" --set fluid.dt=0.01 --set time.max_steps=3 --out "$out" --restart "$out/checkpoint_00000000.h5"
+grep -q "reached max_steps at step 3" "$T/out"
+report $? "the restarted run advanced to step 3"
+
+chmod 600 "$T/noperm.ini"
+tap_end "$T"

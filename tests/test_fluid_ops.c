@@ -1,0 +1,557 @@
+/* test_fluid_ops.c — the fluid's spatial operators, without time stepping:
+ * boundary ghosts, energy conservation of the advection term, consistency
+ * (measured order) of advection and viscous term, the viscous term against
+ * the Laplacian of poisson.c, and the [fluid] input checks.
+ * RANKS: 1 2
+ */
+#include "fluidtest.h"
+#include "modules.h"
+#include "testutil.h"
+
+/* ---- boundary ghosts -------------------------------------------------- */
+
+static double ramp(int c, const double x[3], double t, const void *ctx)
+{
+    (void)t;
+    (void)ctx;
+    return 1.0 + 0.5 * c + x[0] - 2.0 * x[1] + 0.25 * x[2];
+}
+
+/* After fluid_apply_bc: the normal component is 0 on wall and axis faces;
+ * the mean of a tangential ghost and its interior neighbour is the wall
+ * velocity at a no-slip wall (moving walls on every face kind); free-slip
+ * and axis ghosts equal the interior; periodic ghosts hold the image. */
+static void check_ghosts(geom_t geom, const bc_t *bc, stretch_t st)
+{
+    int n[3] = {8, 6, geom == GEOM_3D ? 4 : 1};
+    double L[3] = {1.0, 1.5, 0.75};
+    grid_t *g = grid_create(geom, n, L, NULL, bc, st, 1.5, MPI_COMM_WORLD);
+    fluid_params_t prm = ft_params(0.1, 0);
+    fluid_t *f = fluid_create(g, &prm);
+    ft_set_velocity(f, ramp, 0.0, NULL);
+    int bad = 0;
+    int nxl = g->nxl, ny = g->n[1], nz = g->n[2];
+    for (int c = 0; c < g->dim; c++) {
+        const double *u = f->u[c];
+        /* x faces */
+        for (int s = 0; s < 2 && !g->periodic[0]; s++) {
+            if ((s == 0 && g->left != MPI_PROC_NULL) || (s == 1 && g->right != MPI_PROC_NULL)) continue;
+            for (int j = 0; j < ft_nu(g, c, 1); j++)
+                for (int k = 0; k < ft_nu(g, c, 2); k++) {
+                    if (c == 0) {
+                        if (u[G_IDX(g, s == 0 ? -1 : nxl - 1, j, k)] != 0.0) bad++;
+                        continue;
+                    }
+                    double gh = u[G_IDX(g, s == 0 ? -1 : nxl, j, k)], in = u[G_IDX(g, s == 0 ? 0 : nxl - 1, j, k)];
+                    if (bc->type[0][s] == BC_NOSLIP && fabs(0.5 * (gh + in) - bc->vel[0][s][c]) > 1e-15) bad++;
+                    if (bc->type[0][s] != BC_NOSLIP && gh != in) bad++;
+                }
+        }
+        /* y faces */
+        for (int s = 0; s < 2 && !g->periodic[1]; s++)
+            for (int i = 0; i < ft_iend(g, c); i++)
+                for (int k = 0; k < ft_nu(g, c, 2); k++) {
+                    if (c == 1) {
+                        if (u[G_IDX(g, i, s == 0 ? -1 : ny - 1, k)] != 0.0) bad++;
+                        continue;
+                    }
+                    double gh = u[G_IDX(g, i, s == 0 ? -1 : ny, k)], in = u[G_IDX(g, i, s == 0 ? 0 : ny - 1, k)];
+                    if (bc->type[1][s] == BC_NOSLIP && fabs(0.5 * (gh + in) - bc->vel[1][s][c]) > 1e-15) bad++;
+                    if (bc->type[1][s] != BC_NOSLIP && gh != in) bad++;
+                }
+        /* periodic z (3-D) and the x halo between ranks: images */
+        if (g->dim == 3 && g->periodic[2])
+            for (int i = 0; i < nxl; i++)
+                for (int j = 0; j < ny; j++)
+                    if (u[G_IDX(g, i, j, -1)] != u[G_IDX(g, i, j, nz - 1)] || u[G_IDX(g, i, j, nz)] != u[G_IDX(g, i, j, 0)])
+                        bad++;
+        if (g->left != MPI_PROC_NULL)
+            for (int j = 0; j < ft_nu(g, c, 1); j++) {
+                double x[3];
+                ft_pos(g, c, -1, j, 0, x);
+                if (g->ix0 > 0) /* a neighbour rank's value, not a periodic image */
+                    if (fabs(u[G_IDX(g, -1, j, 0)] - ramp(c, x, 0, NULL)) > 1e-14) bad++;
+            }
+    }
+    bad = (int)grid_sum(g, bad);
+    msg("  ghosts geom %d: %d bad values\n", geom, bad);
+    assert_int_equal(bad, 0);
+    fluid_free(f);
+    grid_free(g);
+}
+
+static void test_ghosts(void **state)
+{
+    bc_t bc = {0};
+    /* 2-D: moving no-slip walls in x and y */
+    bc.type[0][0] = bc.type[0][1] = bc.type[1][0] = bc.type[1][1] = BC_NOSLIP;
+    bc.vel[0][0][1] = 0.3;
+    bc.vel[0][1][1] = -0.7;
+    bc.vel[1][0][0] = 0.2;
+    bc.vel[1][1][0] = 1.0;
+    check_ghosts(GEOM_2D, &bc, STRETCH_TANH_BOTH);
+    /* 3-D: free slip in x, moving no-slip in y, periodic z */
+    memset(&bc, 0, sizeof bc);
+    bc.type[0][0] = bc.type[0][1] = BC_FREESLIP;
+    bc.type[1][0] = bc.type[1][1] = BC_NOSLIP;
+    bc.vel[1][1][0] = 1.0;
+    bc.vel[1][1][2] = -0.5;
+    bc.vel[1][0][2] = 0.25;
+    check_ghosts(GEOM_3D, &bc, STRETCH_UNIFORM);
+    /* axisymmetric: axis, moving pipe wall (axial velocity), free slip in y */
+    memset(&bc, 0, sizeof bc);
+    bc.type[0][0] = BC_AXIS;
+    bc.type[0][1] = BC_NOSLIP;
+    bc.vel[0][1][1] = 0.4;
+    bc.type[1][0] = bc.type[1][1] = BC_FREESLIP;
+    check_ghosts(GEOM_AXI, &bc, STRETCH_TANH_HIGH);
+}
+
+/* ---- divergence-free test fields ---------------------------------------- */
+
+/* A smooth scalar with a few modes, periodic on the box, multiplied by an
+ * envelope that vanishes on every non-periodic face (squared when `clamp`,
+ * so that its gradient vanishes too). */
+typedef struct {
+    const grid_t *g;
+    int clamp;
+    int comp; /* which potential component: changes the coefficients */
+} pot_t;
+
+static double potential(const pot_t *P, const double x[3])
+{
+    const grid_t *g = P->g;
+    static const double amp[3][3] = {{1.0, 0.4, -0.3}, {-0.6, 0.8, 0.25}, {0.5, -0.35, 0.7}};
+    static const int mx[3] = {1, 2, 1}, my[3] = {1, 1, 2}, mz[3] = {2, 1, 1};
+    double s = 0.0;
+    for (int m = 0; m < 3; m++) {
+        double ph = 0.3 * m + 0.7 * P->comp;
+        /* axisymmetric: a function of r² (smooth across the axis) */
+        double xr = g->geom == GEOM_AXI ? x[0] * x[0] / g->L[0] : x[0] - g->x0[0];
+        double t = amp[P->comp][m] * cos(2 * M_PI * mx[m] * xr / g->L[0] + ph) *
+                   cos(2 * M_PI * my[m] * (x[1] - g->x0[1]) / g->L[1] + 0.5 * ph);
+        if (g->dim == 3) t *= cos(2 * M_PI * mz[m] * (x[2] - g->x0[2]) / g->L[2] + 0.2 * ph);
+        s += t;
+    }
+    double env = 1.0;
+    for (int d = 0; d < g->dim; d++)
+        if (!g->periodic[d]) {
+            double e = g->geom == GEOM_AXI && d == 0 ? 1.0 - x[0] * x[0] / (g->L[0] * g->L[0])
+                                                      : sin(M_PI * (x[d] - g->x0[d]) / g->L[d]);
+            env *= P->clamp ? e * e : e;
+        }
+    if (g->geom == GEOM_AXI) env *= x[0] * x[0]; /* ψ ~ r² at the axis: u_z regular */
+    return s * env;
+}
+
+/* Discrete curl of a potential on the edges: exactly D u = 0 in every cell.
+ * 3-D: u = curl_h A; 2-D and axisymmetric: a_f u = −δ_y ψ/Δy,
+ * a_c v = δ_x ψ/Δx_f with ψ on the cell corners. */
+static void set_discrete_curl(fluid_t *f, int clamp)
+{
+    const grid_t *g = f->g;
+    pot_t P[3] = {{g, clamp, 0}, {g, clamp, 1}, {g, clamp, 2}};
+    int axi = g->geom == GEOM_AXI;
+    for (int c = 0; c < g->dim; c++) field_zero(g, f->u[c]);
+    if (g->dim == 2) {
+        FT_FOR_UNKNOWNS(g, 0, i, j, k)
+        {
+            double a[3] = {g->xf[i], grid_yf(g, j), 0}, b[3] = {g->xf[i], grid_yf(g, j - 1), 0};
+            f->u[0][G_IDX(g, i, j, k)] = -(potential(&P[2], a) - potential(&P[2], b)) / (g->dy * (axi ? g->xf[i] : 1));
+        }
+        FT_FOR_UNKNOWNS(g, 1, i, j, k)
+        {
+            double a[3] = {g->xf[i], grid_yf(g, j), 0}, b[3] = {g->xf[i - 1], grid_yf(g, j), 0};
+            f->u[1][G_IDX(g, i, j, k)] =
+                (potential(&P[2], a) - potential(&P[2], b)) / (g->dxf[i] * (axi ? g->xc[i] : 1));
+        }
+    } else {
+        /* A_x on (x_c, y_f, z_f), A_y on (x_f, y_c, z_f), A_z on (x_f, y_f, z_c) */
+#define AX(i, j, k) potential(&P[0], (double[3]){g->xc[i], grid_yf(g, j), grid_zf(g, k)})
+#define AY(i, j, k) potential(&P[1], (double[3]){g->xf[i], grid_yc(g, j), grid_zf(g, k)})
+#define AZ(i, j, k) potential(&P[2], (double[3]){g->xf[i], grid_yf(g, j), grid_zc(g, k)})
+        FT_FOR_UNKNOWNS(g, 0, i, j, k)
+        f->u[0][G_IDX(g, i, j, k)] = (AZ(i, j, k) - AZ(i, j - 1, k)) / g->dy - (AY(i, j, k) - AY(i, j, k - 1)) / g->dz;
+        FT_FOR_UNKNOWNS(g, 1, i, j, k)
+        f->u[1][G_IDX(g, i, j, k)] =
+            (AX(i, j, k) - AX(i, j, k - 1)) / g->dz - (AZ(i, j, k) - AZ(i - 1, j, k)) / g->dxf[i];
+        FT_FOR_UNKNOWNS(g, 2, i, j, k)
+        f->u[2][G_IDX(g, i, j, k)] =
+            (AY(i, j, k) - AY(i - 1, j, k)) / g->dxf[i] - (AX(i, j, k) - AX(i, j - 1, k)) / g->dy;
+#undef AX
+#undef AY
+#undef AZ
+    }
+    fluid_apply_bc(f);
+}
+
+/* Σ_c Σ V_c u_c N_c and its scale Σ |V u N|. */
+static void energy_production(const fluid_t *f, double *const N[3], double *sum, double *scale)
+{
+    const grid_t *g = f->g;
+    double s = 0, a = 0;
+    for (int c = 0; c < g->dim; c++) FT_FOR_UNKNOWNS(g, c, i, j, k)
+        {
+            long m = G_IDX(g, i, j, k);
+            double t = fluid_cell_volume(f, c, i) * f->u[c][m] * N[c][m];
+            s += t;
+            a += fabs(t);
+        }
+    *sum = grid_sum(g, s);
+    *scale = grid_sum(g, a);
+}
+
+/* The advection term conserves the discrete kinetic energy: for a
+ * discretely divergence-free field, Σ V u·N(u) = 0 up to round-off (the
+ * scheme is skew-symmetric, advection.c).  Round-off: a sum of ~10⁴ terms of
+ * relative accuracy 1e-16 cancels to ≲ 1e-13 of Σ|V u N|; a scheme that is
+ * only second-order consistent without the symmetry leaves O(h²) ≈ 1e-3. */
+static void test_advection_energy(void **state)
+{
+    struct {
+        const char *name;
+        geom_t geom;
+        int n[3];
+        bc_type_t bx, by, bz;
+        stretch_t st;
+    } cases[] = {
+        {"3-D triply periodic", GEOM_3D, {16, 12, 8}, BC_PERIODIC, BC_PERIODIC, BC_PERIODIC, STRETCH_UNIFORM},
+        {"3-D stretched no-slip x, free-slip y, no-slip z", GEOM_3D, {16, 12, 10}, BC_NOSLIP, BC_FREESLIP, BC_NOSLIP,
+         STRETCH_TANH_BOTH},
+        {"2-D periodic", GEOM_2D, {16, 24, 1}, BC_PERIODIC, BC_PERIODIC, BC_PERIODIC, STRETCH_UNIFORM},
+        {"2-D stretched box, no-slip", GEOM_2D, {32, 24, 1}, BC_NOSLIP, BC_NOSLIP, BC_PERIODIC, STRETCH_TANH_LOW},
+        {"axisymmetric pipe, stretched, periodic z", GEOM_AXI, {24, 32, 1}, BC_AXIS, BC_PERIODIC, BC_PERIODIC,
+         STRETCH_TANH_HIGH},
+        {"axisymmetric closed cylinder", GEOM_AXI, {16, 24, 1}, BC_AXIS, BC_NOSLIP, BC_PERIODIC, STRETCH_UNIFORM},
+    };
+    for (size_t t = 0; t < sizeof cases / sizeof cases[0]; t++) {
+        bc_t bc = {0};
+        bc.type[0][0] = cases[t].bx;
+        bc.type[0][1] = cases[t].bx == BC_AXIS ? BC_NOSLIP : cases[t].bx;
+        bc.type[1][0] = bc.type[1][1] = cases[t].by;
+        bc.type[2][0] = bc.type[2][1] = cases[t].geom == GEOM_3D ? cases[t].bz : BC_PERIODIC;
+        double L[3] = {1.0, 1.3, 0.8};
+        grid_t *g = grid_create(cases[t].geom, cases[t].n, L, NULL, &bc, cases[t].st, 1.8, MPI_COMM_WORLD);
+        fluid_params_t prm = ft_params(0.01, 0);
+        fluid_t *f = fluid_create(g, &prm);
+        set_discrete_curl(f, 0);
+        double *N[3] = {field_alloc(g), field_alloc(g), g->dim == 3 ? field_alloc(g) : NULL};
+        fluid_advection(f, N);
+        double sum, scale;
+        energy_production(f, N, &sum, &scale);
+        double div = fluid_max_divergence(f);
+        msg("  %-48s Σ V u·N = %.2e of Σ|V u N| = %.3e; max|D u| = %.1e\n", cases[t].name, sum / scale, scale, div);
+        assert_true(div < 1e-11);
+        assert_true(fabs(sum) < 1e-13 * scale);
+        for (int c = 0; c < 3; c++) free(N[c]);
+        fluid_free(f);
+        grid_free(g);
+    }
+}
+
+/* ---- consistency of the advection term --------------------------------- */
+
+/* Analytic divergence-free fields with zero velocity on the walls:
+ * 2-D planar box [0,1]²: ψ = (x(1−x) y(1−y))² (1 + x + 0.5 sin 2πy)... via
+ * the potential above with clamp = 1; axisymmetric: u from ψ(r, z) with
+ * r u_r = −∂zψ, r u_z = ∂rψ.  The exact ∇·(u⊗u) = u·∇u is evaluated by
+ * fourth-order central differences of the analytic velocity (step 1e-3:
+ * error ~1e-11, far below the discretisation error measured). */
+typedef struct {
+    pot_t P;
+} afield_t;
+
+static double fd4(double (*fn)(const afield_t *, int, const double *), const afield_t *a, int c, const double x[3],
+                  int d, double h)
+{
+    double y[3] = {x[0], x[1], x[2]}, s = 0;
+    static const double w[4] = {1, -8, 8, -1}, o[4] = {-2, -1, 1, 2};
+    for (int m = 0; m < 4; m++) {
+        y[d] = x[d] + o[m] * h;
+        s += w[m] * fn(a, c, y);
+    }
+    return s / (12 * h);
+}
+
+static double psi_fn(const afield_t *a, int c, const double *x)
+{
+    (void)c;
+    return potential(&a->P, x);
+}
+
+static double vel_fn(const afield_t *a, int c, const double *x)
+{
+    double r = a->P.g->geom == GEOM_AXI ? x[0] : 1.0;
+    if (c == 0) return -fd4(psi_fn, a, 0, x, 1, 1e-3) / r;
+    return fd4(psi_fn, a, 0, x, 0, 1e-3) / r;
+}
+
+static double advection_error(geom_t geom, stretch_t st, int N, bc_type_t by)
+{
+    int n[3] = {N, N, 1};
+    double L[3] = {1, 1, 1};
+    bc_t bc = {0};
+    bc.type[0][0] = geom == GEOM_AXI ? BC_AXIS : BC_NOSLIP;
+    bc.type[0][1] = BC_NOSLIP;
+    bc.type[1][0] = bc.type[1][1] = by;
+    grid_t *g = grid_create(geom, n, L, NULL, &bc, st, 1.5, MPI_COMM_WORLD);
+    fluid_params_t prm = ft_params(0.01, 0);
+    fluid_t *f = fluid_create(g, &prm);
+    afield_t a = {{g, 1, 2}};
+    double x[3];
+    for (int c = 0; c < 2; c++) FT_FOR_UNKNOWNS(g, c, i, j, k)
+        {
+            ft_pos(g, c, i, j, k, x);
+            f->u[c][G_IDX(g, i, j, k)] = vel_fn(&a, c, x);
+        }
+    fluid_apply_bc(f);
+    double *Nh[3] = {field_alloc(g), field_alloc(g), NULL};
+    fluid_advection(f, Nh);
+    double e = 0;
+    for (int c = 0; c < 2; c++) FT_FOR_UNKNOWNS(g, c, i, j, k)
+        {
+            ft_pos(g, c, i, j, k, x);
+            double ex = vel_fn(&a, 0, x) * fd4(vel_fn, &a, c, x, 0, 1e-3) + vel_fn(&a, 1, x) * fd4(vel_fn, &a, c, x, 1, 1e-3);
+            e = fmax(e, fabs(Nh[c][G_IDX(g, i, j, k)] - ex));
+        }
+    e = grid_max(g, e);
+    free(Nh[0]);
+    free(Nh[1]);
+    fluid_free(f);
+    grid_free(g);
+    return e;
+}
+
+/* The advection term is a second-order approximation of u·∇u for a
+ * divergence-free field with zero wall velocity, everywhere including the
+ * cells next to the walls and the axis, on stretched grids (smooth tanh map)
+ * and with the axisymmetric metric.  Measured max-norm order between 32 and
+ * 64 cells must exceed 1.8 (2 asymptotically; the margin covers the
+ * pre-asymptotic range of the max norm on the stretched grids). */
+static void test_advection_order(void **state)
+{
+    struct {
+        const char *name;
+        geom_t geom;
+        stretch_t st;
+        bc_type_t by;
+    } cases[] = {{"2-D no-slip box, stretched x", GEOM_2D, STRETCH_TANH_BOTH, BC_NOSLIP},
+                 {"2-D channel, periodic y", GEOM_2D, STRETCH_UNIFORM, BC_PERIODIC},
+                 {"axisymmetric pipe, stretched r", GEOM_AXI, STRETCH_TANH_HIGH, BC_PERIODIC},
+                 {"axisymmetric closed cylinder", GEOM_AXI, STRETCH_UNIFORM, BC_NOSLIP}};
+    for (size_t t = 0; t < sizeof cases / sizeof cases[0]; t++) {
+        double e1 = advection_error(cases[t].geom, cases[t].st, 32, cases[t].by);
+        double e2 = advection_error(cases[t].geom, cases[t].st, 64, cases[t].by);
+        double o = conv_order(e1, e2, 2.0);
+        msg("  advection %-34s max error %.3e -> %.3e, order %.2f\n", cases[t].name, e1, e2, o);
+        assert_true(o > 1.8);
+    }
+}
+
+/* ---- viscous term ------------------------------------------------------- */
+
+/* A linear (Couette) profile between moving walls is harmonic, and the
+ * ghost 2U − u is exact for it: the viscous term must vanish in every cell,
+ * including those next to the walls, on a stretched grid.  Two channels:
+ * walls in x (stretched, v linear in x) and walls in y (u linear in y).
+ * Round-off: ν|u|/Δ²_min · 1e-15 ≈ 1e-12 of the scale ν/Δ²_min. */
+static double couette_fn(int c, const double x[3], double t, const void *ctx)
+{
+    (void)t;
+    const double *U = ctx; /* U[0]: wall-normal direction; U[1], U[2]: tangential velocity at the walls */
+    int dw = (int)U[0];
+    return c == dw ? 0.0 : U[1] + (U[2] - U[1]) * x[dw];
+}
+
+static void test_viscous_couette(void **state)
+{
+    int n[3] = {32, 16, 1};
+    double L[3] = {1, 1, 1};
+    for (int dw = 0; dw < 2; dw++)
+        for (int impl = 0; impl < 2; impl++) {
+            double U[3] = {dw, 0.3, -0.7};
+            bc_t bc = {0};
+            bc.type[dw][0] = bc.type[dw][1] = BC_NOSLIP;
+            bc.vel[dw][0][1 - dw] = U[1];
+            bc.vel[dw][1][1 - dw] = U[2];
+            grid_t *g = grid_create(GEOM_2D, n, L, NULL, &bc, dw == 0 ? STRETCH_TANH_BOTH : STRETCH_UNIFORM, 2.0,
+                                    MPI_COMM_WORLD);
+            fluid_params_t prm = ft_params(0.5, impl);
+            fluid_t *f = fluid_create(g, &prm);
+            ft_set_velocity(f, couette_fn, 0, U);
+            double *V[3] = {field_alloc(g), field_alloc(g), NULL};
+            fluid_viscous(f, V);
+            double m = 0;
+            for (int c = 0; c < 2; c++) FT_FOR_UNKNOWNS(g, c, i, j, k) m = fmax(m, fabs(V[c][G_IDX(g, i, j, k)]));
+            m = grid_max(g, m);
+            double dmin = fmin(g->gdxf[0], g->dy);
+            msg("  viscous term of a Couette profile, walls in %c (%s): max %.2e (scale ν/Δ²_min = %.1e)\n",
+                "xy"[dw], impl ? "implicit solvers" : "explicit", m, prm.nu / (dmin * dmin));
+            assert_true(m < 1e-12 * prm.nu / (dmin * dmin));
+            free(V[0]);
+            free(V[1]);
+            fluid_free(f);
+            grid_free(g);
+        }
+}
+
+/* The viscous term is ν times THE Laplacian of poisson.c: equal to
+ * poisson_apply (homogeneous BCs) plus the moving-wall terms 2U·c_wall
+ * (c_wall = 1/Δy² at a y wall, 1/(Δx_c Δx_f) at an x wall), to round-off. */
+static double smooth_fn(int c, const double x[3], double t, const void *ctx)
+{
+    (void)t;
+    (void)ctx;
+    return c == 0 ? sin(2.1 * x[0] + 0.3) * cos(1.7 * x[1]) + x[1] : cos(1.3 * x[0]) * sin(2.5 * x[1] + 0.2) - x[0];
+}
+
+static void test_viscous_is_poisson_operator(void **state)
+{
+    int n[3] = {16, 12, 1};
+    double L[3] = {1, 1, 1};
+    bc_t bc = {0};
+    bc.type[0][0] = bc.type[0][1] = bc.type[1][0] = bc.type[1][1] = BC_NOSLIP;
+    bc.vel[1][0][0] = 0.2;
+    bc.vel[1][1][0] = 1.0;
+    bc.vel[0][0][1] = 0.3;
+    bc.vel[0][1][1] = -0.7;
+    grid_t *g = grid_create(GEOM_2D, n, L, NULL, &bc, STRETCH_TANH_BOTH, 2.0, MPI_COMM_WORLD);
+    double nu = 0.37;
+    fluid_params_t prm = ft_params(nu, 0);
+    fluid_t *f = fluid_create(g, &prm);
+    ft_set_velocity(f, smooth_fn, 0, NULL);
+    double *V[3] = {field_alloc(g), field_alloc(g), NULL};
+    fluid_viscous(f, V);
+    double m = 0, s = 0;
+    for (int c = 0; c < 2; c++) {
+        poisson_t *p = poisson_create_operator(g, (var_loc_t)c);
+        double *x = field_alloc(g), *y = field_alloc(g);
+        field_copy(g, x, f->u[c]);
+        poisson_apply(p, 0.0, x, y);
+        FT_FOR_UNKNOWNS(g, c, i, j, k)
+        {
+            int ig = i + g->ix0;
+            double w = 0;
+            if (c == 0) {
+                if (j == 0) w += 2 * bc.vel[1][0][0] / (g->dy * g->dy);
+                if (j == g->n[1] - 1) w += 2 * bc.vel[1][1][0] / (g->dy * g->dy);
+            } else {
+                if (ig == 0) w += 2 * bc.vel[0][0][1] / (g->gdxc[-1] * g->gdxf[0]);
+                if (ig == g->n[0] - 1) w += 2 * bc.vel[0][1][1] / (g->gdxc[g->n[0] - 1] * g->gdxf[g->n[0] - 1]);
+            }
+            long q = G_IDX(g, i, j, k);
+            m = fmax(m, fabs(V[c][q] - nu * (y[q] + w)));
+            s = fmax(s, fabs(V[c][q]));
+        }
+        free(x);
+        free(y);
+        poisson_free(p);
+    }
+    m = grid_max(g, m);
+    s = grid_max(g, s);
+    msg("  viscous term vs ν(poisson_apply + wall terms): max difference %.2e of %.2e\n", m, s);
+    assert_true(m < 1e-13 * s);
+    free(V[0]);
+    free(V[1]);
+    fluid_free(f);
+    grid_free(g);
+}
+
+/* ---- bad input -------------------------------------------------------- */
+
+static jmp_buf jb;
+static char last_msg[1024];
+static int parsing;
+/* The parser reports its errors and returns NULL (the hook may return); any
+ * later check stops through cfg_fail, whose hook must not return. */
+static void hook(const char *m)
+{
+    if (!last_msg[0]) snprintf(last_msg, sizeof last_msg, "%s", m);
+    if (!parsing) longjmp(jb, 1);
+}
+
+static const char *base_case = "[domain]\ngeometry = %s\nnx = 8\nny = 8\nnz = %d\nlength = 1 1 1\n"
+                               "[boundary]\n%s\n[fluid]\n%s\n";
+
+/* Load a case, build the grid and the fluid and set the initial condition;
+ * returns the error message, or "" when everything was accepted. */
+static const char *try_case(const char *geom, const char *boundary, const char *fluid)
+{
+    char text[2048];
+    snprintf(text, sizeof text, base_case, geom, strcmp(geom, "3d") ? 1 : 8, boundary, fluid);
+    static cfg_t *cfg;
+    static grid_t *g;
+    static fluid_t *f;
+    cfg = NULL;
+    g = NULL;
+    f = NULL;
+    last_msg[0] = 0;
+    cfg_set_error_hook(hook);
+    if (!setjmp(jb)) {
+        parsing = 1;
+        cfg = cfg_load_string("case.ini", text, 0, NULL);
+        parsing = 0;
+        if (cfg) {
+            g = grid_create_from_config(cfg, MPI_COMM_WORLD);
+            fluid_params_t prm;
+            fluid_params_from_config(cfg, g, &prm);
+            f = fluid_create(g, &prm);
+            fluid_init_from_config(f, cfg);
+        }
+    }
+    cfg_set_error_hook(NULL);
+    fluid_free(f);
+    grid_free(g);
+    if (cfg) cfg_free(cfg);
+    return last_msg;
+}
+
+static void expect_error(const char *geom, const char *boundary, const char *fluid, const char *needle)
+{
+    const char *m = try_case(geom, boundary, fluid);
+    msg("  [%s] -> %s\n", needle, m[0] ? m : "(accepted)");
+    assert_non_null(strstr(m, needle));
+}
+
+static void test_bad_input(void **state)
+{
+    const char *per = "";
+    const char *chan = "y_lo = noslip\ny_hi = noslip";
+    /* accepted */
+    assert_string_equal(try_case("2d", chan, "nu = 0.1\ninit = laminar\nbody_force = 1 0 0"), "");
+    assert_string_equal(try_case("3d", per, "nu = 0.1\ninit = abc"), "");
+    /* missing, out of range, wrong type: the parser and the getters */
+    expect_error("2d", per, "rho = 2", "fluid.nu: missing key");
+    expect_error("2d", per, "nu = -1", "case.ini:10: fluid.nu: -1 is out of range");
+    expect_error("2d", per, "nu = 0.1\nviscous = semi", "case.ini:11: fluid.viscous:");
+    expect_error("2d", per, "nu = 0.1\ncfl = 2", "case.ini:11: fluid.cfl: 2 is out of range");
+    /* cross-field consistency */
+    expect_error("2d", per, "nu = 0.1\nbody_force = 0 0 1", "case.ini:11: fluid.body_force: a 2-D grid");
+    expect_error("axisymmetric", "x_lo = axis\nx_hi = noslip", "nu = 0.1\nbody_force = 1 0 0",
+                 "fluid.body_force: an axisymmetric body force must be axial");
+    expect_error("2d", per, "nu = 0.1\ndt = 0.5\ndt_max = 0.1", "fluid.dt: the fixed step");
+    expect_error("2d", chan, "nu = 0.1\ninit = taylor_green", "fluid.init: taylor_green needs periodic");
+    expect_error("axisymmetric", "x_lo = axis\nx_hi = noslip", "nu = 0.1\ninit = taylor_green",
+                 "fluid.init: taylor_green needs a Cartesian");
+    expect_error("2d", per, "nu = 0.1\ninit = abc", "fluid.init: abc needs a triply periodic 3d grid");
+    expect_error("2d", per, "nu = 0.1\ninit = laminar", "fluid.init: laminar needs one wall-bounded direction");
+    expect_error("2d", "x_lo = noslip\nx_hi = noslip\ny_lo = noslip\ny_hi = noslip", "nu = 0.1\ninit = laminar",
+                 "fluid.init: laminar needs exactly one wall-bounded direction");
+    expect_error("2d", "y_lo = noslip\ny_hi = freeslip", "nu = 0.1\ninit = laminar",
+                 "fluid.init: laminar needs no-slip walls");
+}
+
+int main(int argc, char **argv)
+{
+    test_mpi_init(&argc, &argv);
+    modules_register_keys();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_ghosts),
+        cmocka_unit_test(test_advection_energy),
+        cmocka_unit_test(test_advection_order),
+        cmocka_unit_test(test_viscous_couette),
+        cmocka_unit_test(test_viscous_is_poisson_operator),
+        cmocka_unit_test(test_bad_input),
+    };
+    TEST_MPI_RUN("fluid_ops", tests);
+}
