@@ -38,12 +38,20 @@
  * reordered as v(n) = x(2n), v(N−1−n) = x(2n+1) (Makhoul 1980): with
  * V = DFT(v) and W = e^{−iπ/2N}, DCT-II_k(x) = 2 Re(W^k V_k).  In 2-D
  * (y, z), pairing row k1 with N1−k1 (and using V(k1, −k2) = conj V(−k1, k2))
- * gives every output of a pair of rows from two complex numbers, in one
- * pass over the data (fast_butterfly); its exact inverse runs before the
- * inverse DFT (c2r).  The z modes are then stored as slot 2k ↔ mode k, slot
- * 2k+1 ↔ mode N−k (slot 1 holds 0, slot N+1 repeats mode N/2).  Other
- * boundary pairs, odd sizes and 2-D grids use FFTW's r2r kinds directly
- * (batched 1-D plans: faster than rank-2 r2r plans, measured).
+ * gives every output of a pair of rows from two complex numbers (a
+ * "butterfly", bf_*); its exact inverse runs before the inverse DFT (c2r).
+ * The z modes are then stored as slot 2k ↔ mode k, slot 2k+1 ↔ mode N−k
+ * (slot 1 holds 0, slot N+1 repeats mode N/2).  The reordering is done plane
+ * by plane into a buffer that stays in cache (plane_transforms), and on one
+ * rank the butterflies run inside the tridiagonal sweeps (blocks pair rows
+ * k1 and N1−k1), so this path makes no more passes over memory than a
+ * transform from the field; with several ranks the pair of rows may be split
+ * among them and the butterfly is a pass of its own (fast_butterfly).
+ * Other boundary pairs, odd sizes and 2-D grids use FFTW's r2r kinds
+ * directly (batched 1-D plans: faster than rank-2 r2r plans, measured).
+ *
+ * Memory: the transformed data live in scratch arrays shared by the solvers
+ * of all locations (scratch_*): one field's worth on one rank, two with MPI.
  *
  * MPI: the field is split in x slabs.  The transforms are local to each x
  * plane; their output is written in the order [y row][i][z slot], so each
