@@ -38,6 +38,10 @@ $(BUILD)/obj/%.o: src/%.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
 
+# The DEM kernels take square roots of non-negative numbers only: without errno
+# handling the contact loop of src/dem/dem_kernel.inc vectorises (SIMD).
+$(BUILD)/obj/dem/%.o: CFLAGS += -fno-math-errno
+
 $(LIB): $(OBJ)
 	@rm -f $@
 	ar rcs $@ $^

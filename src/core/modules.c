@@ -1,6 +1,7 @@
 /* modules.c — one place that knows every module's schema of keys. */
 #include "modules.h"
 
+#include "dem.h"
 #include "fluid.h"
 #include "grid.h"
 #include "poisson.h"
@@ -14,4 +15,5 @@ void modules_register_keys(void)
     fluid_register_keys();
     porenet_register_keys();
     sim_register_keys();
+    dem_register_keys();
 }
