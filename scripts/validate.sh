@@ -83,7 +83,22 @@ else
 fi
 rm -rf "$d"
 
-# (fluid, poisson, dem: add sections here)
+
+# --- fluid: lid-driven cavity series, Re = 100 (Crank-Nicolson) and Re = 1000
+# (explicit) on 64^2, 128^2, 256^2 to steady state, Richardson-extrapolated with
+# the observed order and compared with Ghia et al. (1982) and with the extrema of
+# Botella & Peyret (1998) / Marchi et al. (2009) (cases/cavity/*.csv).  Measured
+# (docs/validation.md): orders 2.06 and 1.89, extrapolated extrema within 1.2e-5
+# and 1.0e-4 of the references.  Asserts order > 1.6, the limit closer to the
+# reference than half the 256^2 error, the limit within 0.012 / 0.02 of Ghia.
+# About 10 minutes on one quiet core (256^2 at Re = 1000: 20 600 steps).
+section "fluid: cavity Re = 100 and 1000, 64^2 to 256^2, Richardson extrapolation"
+IBMDEM_VALIDATE=1 $MPIRUN -np 1 "$BUILD/tests/test_fluid_cavity" >"$OUT/fluid_cavity.txt" 2>&1
+rc=$?
+cat "$OUT/fluid_cavity.txt"
+[ "$rc" = 0 ] || fail "fluid cavity series"
+
+# (poisson, dem: add sections here)
 
 echo
 if [ -n "$failed" ]; then echo "validate: FAILED:$failed"; exit 1; fi

@@ -80,6 +80,7 @@ fluid_t *fluid_create(grid_t *g, const fluid_params_t *prm)
     }
     f->p = field_alloc(g);
     q->work = field_alloc(g);
+    q->halo_buf = xcalloc((size_t)6 * g->sx, sizeof(double));
     q->pp = poisson_create(g, VAR_P, &prm->poisson);
 
     int nxl = g->nxl;
@@ -108,6 +109,7 @@ void fluid_free(fluid_t *f)
     }
     free(f->p);
     free(q->work);
+    free(q->halo_buf);
     poisson_free(q->pp);
     free(q->af - 1);
     free(q->ac - 1);

@@ -12,6 +12,7 @@ typedef struct {
     double *dudt[3];       /* explicit right-hand side of the current RK stage */
     double *dudt_old[3];   /* ... of the previous stage (the ζ term) */
     double *work;          /* scratch: the pressure correction φ, the Helmholtz right-hand sides */
+    double *halo_buf;      /* send and receive buffers of the combined x halo (2 × 3 planes) */
     /* metric of the local x range, index −1..nxl (stored at +1): face and
      * centre area factors (r in axisymmetric geometry, 1 otherwise) */
     double *af, *ac;
@@ -55,7 +56,6 @@ void fluid_laplacian_add(const fluid_t *f, int c, const double *u, double scale,
 void fluid_wall_terms_add(const fluid_t *f, int c, double scale, double *out);
 void fluid_viscous_setup(fluid_t *f);
 /* bc.c */
-void fluid_fill_ghosts_component(const fluid_t *f, int c, double *u);
 void fluid_fill_pressure_ghosts(const fluid_t *f, double *p);
 /* timestep.c: max over cells of Σ_d |u_d|/Δ_d (|u_d| the larger of the two faces) */
 double fluid_convective_rate(const fluid_t *f);
