@@ -20,7 +20,7 @@ BUILD   ?= build
 OPT     := -O3 -march=native -g
 endif
 CFLAGS  := $(STD) $(OPT) $(WARN) -Iinclude $(HDF5_CFLAGS) $(EXTRA_CFLAGS)
-LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -linih -lgsl -lgslcblas -lm
+LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -linih -lgsl -lgslcblas -lqhull_r -lcholmod -lsuitesparseconfig -lm
 TESTLIBS := -lcmocka
 
 SRC     := $(filter-out src/main.c,$(shell find src -name '*.c' | sort))
@@ -37,6 +37,10 @@ all: $(BIN) $(TESTS) $(BENCHES)
 $(BUILD)/obj/%.o: src/%.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
+
+# The DEM kernels take square roots of non-negative numbers only: without errno
+# handling the contact loop of src/dem/dem_kernel.inc vectorises (SIMD).
+$(BUILD)/obj/dem/%.o: CFLAGS += -fno-math-errno
 
 $(LIB): $(OBJ)
 	@rm -f $@
