@@ -98,7 +98,11 @@ rc=$?
 cat "$OUT/fluid_cavity.txt"
 [ "$rc" = 0 ] || fail "fluid cavity series"
 
-# (poisson, dem: add sections here)
+# --- dem: full column collapse and rough inclined plane (scripts/validate_dem.sh)
+section "dem: column collapse and inclined plane (full size)"
+BUILD=$BUILD OUT=$OUT bash scripts/validate_dem.sh || fail "dem cases"
+
+# (further modules: add sections here)
 
 echo
 if [ -n "$failed" ]; then echo "validate: FAILED:$failed"; exit 1; fi
