@@ -185,6 +185,9 @@ typedef struct {
     int built;
     double *p, *vol, *vol_prev, *dvdt, *x_prev;
     double *f, *fp, *fv;
+    double *x_cont;     /* previous positions continuous with the current ones (periodic unwrapping) */
+    double *xid, *rid;  /* DEM coupling: positions / radii in the order of the particle ids (couple.c) */
+    double dt_factor;   /* ζ of the coupled time step (thesis 4.21) */
     double eps_acc;     /* accumulated pore strain since the last triangulation */
     long n_retri, n_steps;
     /* wall times: last triangulation / network / factorisation, cumulated solve and force times */
@@ -207,6 +210,22 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r);
  * Re-triangulates when due, solves, computes m->f.  0 or -1 (m->err). */
 int pn_model_step(pn_model_t *m, int n, const double *x, const double *r, double dt);
 void pn_model_free(pn_model_t *m);
+
+/* ---- coupling with the DEM engine (couple.c) ------------------------------------- */
+
+struct dem;
+/* One coupled step after the DEM moved during dt (thesis fig. 4.3, 5.9):
+ * gathers the particle positions in the order of their ids (the DEM reorders
+ * its arrays), steps the model (pore volume rates from the motion, solve,
+ * forces) and writes the fluid force plus the buoyancy −ρ_f V g of the
+ * hydrostatic part into dem_ext_force() (the pore pressures are excess
+ * pressures; the model's forces act through the centres: zero torque).
+ * dt <= 0: rigid skeleton (the initial state).  0 or -1 (m->err). */
+int pn_model_couple_dem(pn_model_t *m, struct dem *d, const double g[3], double dt);
+/* Time-step limit of the coupled problem, ζ · min_k Δt_{M−V} with the viscous
+ * limit of each mobile particle Δt_{M−V} = π ρ_k d_k²/(1200 μ) = M_k/(200 μ d_k)
+ * (thesis 4.19–4.22, β = 400 calibrated for d_max/d_min ≤ 10). */
+double pn_coupled_dt(const pn_model_t *m, const struct dem *d);
 
 /* Permeability along axis a: imposed-pressure faces on both ends of a
  * walled axis (κ = μ Q L/(ΔP S)), or a mean gradient on a periodic axis

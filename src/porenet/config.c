@@ -27,10 +27,12 @@ static const cfg_key_t porenet_keys[] = {
     {"porenet", "pcg_tol", CFG_DOUBLE, "1e-10", 1e-16, 1e-2, NULL, "pcg: relative residual at which CG stops"},
     {"porenet", "retriangulate", CFG_DOUBLE, "0.01", 0, 10, NULL,
      "re-triangulate when the accumulated largest pore volume strain exceeds this (thesis 5.13-5.14); 0: every step"},
+    {"porenet", "dt_factor", CFG_DOUBLE, "0.8", 1e-6, 1, NULL,
+     "with DEM particles: time step = dt_factor x the viscous limit pi rho d^2/(1200 mu) (thesis 4.20-4.22)"},
     {"porenet", "margin", CFG_DOUBLE, "0", 0, BIG, NULL,
      "width of the layer of sphere images across the faces (m); 0: 3 largest diameters"},
     {"porenet", "packing", CFG_STRING, NULL, 1, 0, NULL,
-     "fixed packing (text: x y z r per line, # comments) when the scene has no DEM particles"},
+     "fixed packing (text: x y z r per line, # comments) when the scene has no DEM particles ([particles])"},
     {"porenet", "gradient", CFG_VEC3, "0 0 0", -BIG, BIG, NULL,
      "mean pressure gradient imposed along the periodic axes (Pa/m)"},
     FACE_KEYS("x_lo"), FACE_KEYS("x_hi"), FACE_KEYS("y_lo"), FACE_KEYS("y_hi"), FACE_KEYS("z_lo"), FACE_KEYS("z_hi"),
@@ -78,4 +80,5 @@ void pn_model_from_config(cfg_t *cfg, pn_model_t *m)
     m->pcg_tol = cfg_double(cfg, "porenet", "pcg_tol");
     m->eps_retri = cfg_double(cfg, "porenet", "retriangulate");
     m->margin = cfg_double(cfg, "porenet", "margin");
+    m->dt_factor = cfg_double(cfg, "porenet", "dt_factor");
 }

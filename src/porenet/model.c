@@ -22,6 +22,9 @@ void pn_model_free(pn_model_t *m)
     free(m->f);
     free(m->fp);
     free(m->fv);
+    free(m->x_cont);
+    free(m->xid);
+    free(m->rid);
     free(m->snap_time);
     free(m->snap_counts);
     m->snap_time = NULL;
@@ -29,6 +32,7 @@ void pn_model_free(pn_model_t *m)
     m->nsnap = 0;
     m->sol = NULL;
     m->p = m->vol = m->vol_prev = m->dvdt = m->x_prev = m->f = m->fp = m->fv = NULL;
+    m->x_cont = m->xid = m->rid = NULL;
     m->built = 0;
 }
 
@@ -59,6 +63,7 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
         m->fp = realloc(m->fp, 3 * (size_t)n * sizeof *m->fp);
         m->fv = realloc(m->fv, 3 * (size_t)n * sizeof *m->fv);
         m->x_prev = realloc(m->x_prev, 3 * (size_t)n * sizeof *m->x_prev);
+        m->x_cont = realloc(m->x_cont, 3 * (size_t)n * sizeof *m->x_cont);
     }
     m->n = n;
     m->built = 1;
@@ -67,18 +72,43 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
     return 0;
 }
 
+/* A sphere crossed a periodic face since the previous step (its centre was
+ * brought back into the box): the topology, built with its old position and
+ * images, no longer follows it. */
+static int wrapped(const pn_model_t *m, int n, const double *x)
+{
+    for (int a = 0; a < 3; a++) {
+        if (!m->dom.periodic[a]) continue;
+        const double half = 0.5 * (m->dom.hi[a] - m->dom.lo[a]);
+        for (int i = 0; i < n; i++)
+            if (fabs(x[3 * i + a] - m->x_prev[3 * i + a]) > half) return 1;
+    }
+    return 0;
+}
+
 int pn_model_step(pn_model_t *m, int n, const double *x, const double *r, double dt)
 {
     int moving = m->built && dt > 0 && n == m->n;
-    if (!m->built || n != m->n || m->eps_acc > m->eps_retri || m->eps_retri == 0) {
+    if (!m->built || n != m->n || m->eps_acc > m->eps_retri || m->eps_retri == 0 || (moving && wrapped(m, n, x))) {
         if (pn_model_rebuild(m, n, x, r)) return -1;
     }
     int np = m->net.npore;
     double t0 = wtime();
     if (moving) {
+        /* previous positions continuous with x (periodic unwrapping: the
+         * topology now follows x) */
+        for (int i = 0; i < 3 * n; i++) {
+            const int a = i % 3;
+            double xp = m->x_prev[i];
+            if (m->dom.periodic[a]) {
+                const double L = m->dom.hi[a] - m->dom.lo[a];
+                xp -= L * nearbyint((xp - x[i]) / L);
+            }
+            m->x_cont[i] = xp;
+        }
         /* rate of change of the pore volumes on the current topology, from
          * the positions at the start and the end of the step (4.8) */
-        pn_pore_volumes(&m->dom, &m->tri, &m->net, m->x_prev, m->vol_prev);
+        pn_pore_volumes(&m->dom, &m->tri, &m->net, m->x_cont, m->vol_prev);
         pn_pore_volumes(&m->dom, &m->tri, &m->net, x, m->vol);
         double emax = 0;
         for (int i = 0; i < np; i++) {
