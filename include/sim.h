@@ -134,5 +134,9 @@ extern const char *const sim_run_control_keys[];
 void sim_add_fluid(sim_t *s, cfg_t *cfg);
 /* The DEM part (sim_dem.c): built when the case has a [particles] section. */
 void sim_add_dem(sim_t *s, cfg_t *cfg);
+/* The DEM engine of the run (its packing prepared), NULL without particles. */
+struct dem *sim_dem_engine(sim_t *s);
+/* The pore-network fluid (sim_porenet.c): built when the case has a [porenet] section. */
+void sim_add_porenet(sim_t *s, cfg_t *cfg);
 
 #endif

@@ -5,6 +5,7 @@
 #include "fluid.h"
 #include "grid.h"
 #include "poisson.h"
+#include "porenet.h"
 #include "sim.h"
 
 void modules_register_keys(void)
@@ -12,6 +13,7 @@ void modules_register_keys(void)
     grid_register_keys();
     poisson_register_keys();
     fluid_register_keys();
+    porenet_register_keys();
     sim_register_keys();
     dem_register_keys();
 }

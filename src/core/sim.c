@@ -150,7 +150,8 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
     /* Parts of the scene, in the order they advance. */
     if (cfg_has_section(cfg, "fluid")) sim_add_fluid(s, cfg);
     if (cfg_has_section(cfg, "particles")) sim_add_dem(s, cfg);
-    /* (immersed boundary coupling, pore network: add here) */
+    if (cfg_has_section(cfg, "porenet")) sim_add_porenet(s, cfg);
+    /* (immersed boundary coupling: add here) */
 
     if (s->npart == 0) {
         if (mpi_rank() == 0) fprintf(stderr, "%s: nothing to simulate: the case has no [fluid] or [particles] section (with at least one key)\n", cfg_path(cfg));

@@ -159,6 +159,17 @@ static void part_destroy(void *ctx)
     free(dp);
 }
 
+dem_t *sim_dem_engine(sim_t *s)
+{
+    for (int p = 0; p < s->npart; p++)
+        if (!strcmp(s->part[p].name, "dem")) {
+            dem_part_t *dp = s->part[p].ctx;
+            ensure_prepared(dp);
+            return dp->d;
+        }
+    return NULL;
+}
+
 void sim_add_dem(sim_t *s, cfg_t *cfg)
 {
     dem_part_t *dp = xcalloc(1, sizeof *dp);
@@ -167,7 +178,8 @@ void sim_add_dem(sim_t *s, cfg_t *cfg)
     dp->d = dem_create_from_config(cfg, s->comm);
     dp->substeps = cfg_int(cfg, "dem", "substeps");
     dp->rest_after = cfg_double(cfg, "dem", "rest_after");
-    dp->with_fluid = cfg_has_section(cfg, "fluid");
+    /* a fluid (resolved or pore network) sets the step; the DEM sub-cycles in it */
+    dp->with_fluid = cfg_has_section(cfg, "fluid") || cfg_has_section(cfg, "porenet");
     if (dem_count(dp->d) == 0) cfg_fail(cfg, "particles", "source", "the scene has no particles");
     sim_part_t part = {
         .name = "dem",

@@ -16,6 +16,9 @@ static const cfg_key_t poisson_keys[] = {
     {"poisson", "mg_max_cycles", CFG_INT, "100", 1, 10000, NULL, "multigrid: maximum number of V-cycles"},
     {"poisson", "mg_pre", CFG_INT, "2", 0, 20, NULL, "multigrid: pre-smoothing sweeps"},
     {"poisson", "mg_post", CFG_INT, "2", 0, 20, NULL, "multigrid: post-smoothing sweeps"},
+    {"poisson", "fftw_planner", CFG_ENUM, "estimate", 1, 0, "estimate|measure",
+     "fft: FFTW planner; measure times candidate algorithms at start-up and is faster, but may pick "
+     "different ones from run to run, so results are then not bit-identical between runs (or a restart)"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL}};
 
 void poisson_register_keys(void) { cfg_schema_add(poisson_keys); }
@@ -27,6 +30,7 @@ void poisson_opts_from_config(cfg_t *cfg, poisson_opts_t *o)
     o->mg_max_cycles = cfg_int(cfg, "poisson", "mg_max_cycles");
     o->mg_pre = cfg_int(cfg, "poisson", "mg_pre");
     o->mg_post = cfg_int(cfg, "poisson", "mg_post");
+    o->fftw_measure = cfg_enum(cfg, "poisson", "fftw_planner") == 1;
 }
 
 /* Homogeneous BC of face (d, s) for location loc. */
@@ -253,7 +257,7 @@ int poisson_solve(poisson_t *p, double lambda, const double *b, double *x)
     if (!p->backend) die("poisson_solve: operator created without a solver (poisson_create_operator)");
     const double *rhs = b;
     double *tmp = NULL;
-    int sing = p->singular && lambda == 0.0;
+    int sing = p->singular && lambda == 0.0 && !p->backend_handles_singular;
     if (sing) {
         /* Remove the incompatible part (weighted mean) of b. */
         double m = poisson_weighted_mean(p, b);
