@@ -20,7 +20,7 @@ BUILD   ?= build
 OPT     := -O3 -march=native -g
 endif
 CFLAGS  := $(STD) $(OPT) $(WARN) -Iinclude $(HDF5_CFLAGS) $(EXTRA_CFLAGS)
-LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -linih -lgsl -lgslcblas -lqhull_r -lcholmod -lsuitesparseconfig -lm
+LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -linih -lgsl -lgslcblas -lqhull_r -lcholmod -lsuitesparseconfig -lm -fopenmp
 TESTLIBS := -lcmocka
 
 SRC     := $(filter-out src/main.c,$(shell find src -name '*.c' | sort))
@@ -39,8 +39,9 @@ $(BUILD)/obj/%.o: src/%.c
 	$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
 
 # The DEM kernels take square roots of non-negative numbers only: without errno
-# handling the contact loop of src/dem/dem_kernel.inc vectorises (SIMD).
-$(BUILD)/obj/dem/%.o: CFLAGS += -fno-math-errno
+# handling the contact loop of src/dem/dem_kernel.inc vectorises (SIMD).  The
+# DEM uses OpenMP threads ([dem] threads; one thread by default).
+$(BUILD)/obj/dem/%.o: CFLAGS += -fno-math-errno -fopenmp
 
 $(LIB): $(OBJ)
 	@rm -f $@

@@ -5,7 +5,7 @@
  * damping, no rolling resistance, normal force not clipped as in LIGGGHTS'
  * default), dt = 2e-6 s, skin 0.1 d, gravity −9.81 z.
  *
- * usage: bench_dem DATA NSTEPS TAG [OUT.data] [replicated|split]
+ * usage: bench_dem DATA NSTEPS TAG [OUT.data] [replicated|split] [THREADS]
  * Prints one line "BENCH tag ..." with the loop time, particle-steps/s and the
  * fingerprint of the final state (as the LIGGGHTS input computes it:
  * centre-of-mass height, packing fraction N V_p/(L_x L_y 2 z̄), mean
@@ -26,7 +26,7 @@ int main(int argc, char **argv)
 {
     MPI_Init(&argc, &argv);
     if (argc < 4) {
-        msg("usage: bench_dem DATA NSTEPS TAG [OUT.data] [replicated|split]\n");
+        msg("usage: bench_dem DATA NSTEPS TAG [OUT.data] [replicated|split] [THREADS]\n");
         MPI_Finalize();
         return 1;
     }
@@ -36,14 +36,15 @@ int main(int argc, char **argv)
     const char *tag = argv[3];
     const char *out = argc > 4 && strcmp(argv[4], "-") ? argv[4] : NULL;
     const char *par = argc > 5 ? argv[5] : "auto";
+    const int threads = argc > 6 ? atoi(argv[6]) : 1;
     char text[2048];
     snprintf(text, sizeof text,
              "[boundary]\nx_lo = noslip\nx_hi = noslip\ny_lo = noslip\ny_hi = noslip\nz_lo = noslip\nz_hi = noslip\n"
              "[particles]\nsource = lammps_data\nfile = %s\n"
              "[contact]\nlaw = linear\nparameters = stiffness\nkn = 5419.27738987\ngamma_n = 13862.9436112\n"
              "kt_ratio = 0.285714285714285714\nfriction = 0.5\nnormal_clip = false\n"
-             "[dem]\ngravity = 0 0 -9.81\ndt = 2e-6\nskin = 0.1\nmax_overlap = 0.2\nparallel = %s\n",
-             data, par);
+             "[dem]\ngravity = 0 0 -9.81\ndt = 2e-6\nskin = 0.1\nmax_overlap = 0.2\nparallel = %s\nthreads = %d\n",
+             data, par, threads);
     cfg_t *cfg = cfg_load_string("bench_dem", text, 0, NULL);
     if (!cfg) die("bench_dem: bad configuration");
     const long rss0 = peak_rss_bytes();
@@ -90,10 +91,10 @@ int main(int argc, char **argv)
     const double zmean = 2.0 * g.n_contacts / n;
     const double pps = loop > 0 ? (double)n * nsteps / loop : 0;
     const long rss = peak_rss_bytes();
-    msg("BENCH %s: ranks= %d N= %d steps= %ld loop= %.4f s particle_steps_per_s= %.6g zbar= %.10g zmax= %.10g "
+    msg("BENCH %s: ranks= %d threads= %d N= %d steps= %ld loop= %.4f s particle_steps_per_s= %.6g zbar= %.10g zmax= %.10g "
         "phi_com= %.6f Zmean= %.5f ke= %.6g mem_alloc_per_particle= %.1f B peak_rss_per_particle= %.1f B "
         "(rss growth %.1f B) rebuilds= %ld\n",
-        tag, mpi_size(), n, nsteps, loop, pps, g.com[2], zmax, phi, zmean, g.ke_trans, dem_memory_per_particle(d),
+        tag, mpi_size(), threads, n, nsteps, loop, pps, g.com[2], zmax, phi, zmean, g.ke_trans, dem_memory_per_particle(d),
         (double)rss / n, (double)(rss - rss0) / n, g.rebuilds);
     dem_print_timers(d);
     if (out) dem_write_lammps_data(d, out);

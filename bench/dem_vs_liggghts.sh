@@ -8,7 +8,8 @@
 # bed of phase D (150 000 steps from the initial state, run by ibmdem and
 # written as a LAMMPS data file; cached in the work directory), then phase S
 # (settling, 20 000 steps) and phase D (dense bed, 10 000 steps) with both
-# codes on 1 and 2 ranks.  Reports particle-steps/s (N × steps / loop wall
+# codes on 1 and 2 ranks (and ibmdem on 1 rank with 2 OpenMP threads, compared with
+# LIGGGHTS on 2 ranks).  Reports particle-steps/s (N × steps / loop wall
 # time), the ratio ibmdem/LIGGGHTS, the fingerprints (centre-of-mass height,
 # packing fraction, mean coordination number) and the memory per particle,
 # and writes the table to $WORK/dem_bench.md.
@@ -72,6 +73,13 @@ for N in $SIZES; do
             par=replicated; [ $np -gt 1 ] && par=split
             $MPIRUN -np $np "$BENCH" $data $steps ibm_$tag - $par > ibm_$tag.out 2>&1 || { echo "ibmdem failed, see $WORK/ibm_$tag.out"; exit 1; }
             echo "$phase $N $np $steps lig_$tag.out ibm_$tag.out" >> "$results"
+            if [ $np -gt 1 ]; then
+                # the same with one rank and $np OpenMP threads ([dem] threads)
+                echo "dem bench: phase $phase, N = $N, 1 rank x $np threads: ibmdem"
+                $MPIRUN -np 1 "$BENCH" $data $steps ibm_${tag}t - replicated $np > ibm_${tag}t.out 2>&1 ||
+                    { echo "ibmdem failed, see $WORK/ibm_${tag}t.out"; exit 1; }
+                echo "$phase $N ${np}t $steps lig_$tag.out ibm_${tag}t.out" >> "$results"
+            fi
         done
     done
 done
@@ -81,11 +89,13 @@ import re, sys
 rows = [l.split() for l in open(sys.argv[1]) if l.strip()]
 out = []
 out.append("Indicative numbers (shared, loaded machine; the lead re-measures on a quiet one).\n")
+out.append("ranks: MPI ranks of both codes; 2t: LIGGGHTS on 2 ranks, ibmdem on 1 rank with 2 threads.\n")
 out.append("| phase | N | ranks | LIGGGHTS p-steps/s | ibmdem p-steps/s | ratio | z_com L / i (mm) | phi L / i | Z L / i | B/particle L / i |")
 out.append("|---|---|---|---|---|---|---|---|---|---|")
 worst = []
 for phase, N, np_, steps, lf, bf in rows:
-    N, np_, steps = int(N), int(np_), int(steps)
+    threads = np_.endswith("t")
+    N, np_, steps = int(N), int(np_.rstrip("t")), int(steps)
     lt = open(lf).read()
     loop = float(re.search(r"Loop time of ([0-9.eE+-]+) on \d+ procs for %d steps" % steps, lt).group(1))
     fp = re.search(r"FINGERPRINT \S+: zbar= (\S+) zmax= (\S+) phi_com= (\S+) Zmean= (\S+)", lt)
@@ -98,9 +108,9 @@ for phase, N, np_, steps, lf, bf in rows:
                   r"mem_alloc_per_particle= (\S+) B peak_rss_per_particle= (\S+) B", bt)
     ipps, iz, iphi, iZ, imem, irss = (float(m.group(k)) for k in (1, 2, 4, 5, 6, 7))
     ratio = ipps / lpps
-    worst.append((ratio, phase, N, np_))
-    out.append("| %s | %d | %d | %.3g | %.3g | %.2f | %.4f / %.4f | %.4f / %.4f | %.3f / %.3f | %.0f / %.0f (rss %.0f) |"
-               % (phase, N, np_, lpps, ipps, ratio, 1e3 * lz, 1e3 * iz, lphi, iphi, lZ, iZ, lmem, imem, irss))
+    worst.append((ratio, phase, N, np_ if not threads else 0))
+    out.append("| %s | %d | %s | %.3g | %.3g | %.2f | %.4f / %.4f | %.4f / %.4f | %.3f / %.3f | %.0f / %.0f (rss %.0f) |"
+               % (phase, N, "%dt" % np_ if threads else str(np_), lpps, ipps, ratio, 1e3 * lz, 1e3 * iz, lphi, iphi, lZ, iZ, lmem, imem, irss))
     dphi, dZ = abs(iphi / lphi - 1), abs(iZ / lZ - 1) if lZ > 0.05 else abs(iZ - lZ)
     if dphi > 0.02 or (lZ > 0.05 and dZ > 0.02):
         out.append("|  | fingerprint differs by more than 2 %% (phi %.2f %%, Z %.2f %%) | | | | | | | | |" % (100 * dphi, 100 * dZ))

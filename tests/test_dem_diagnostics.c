@@ -94,6 +94,23 @@ static void test_timestep(void **state)
     dem_free(d);
 }
 
+/* Load and build a scene from `text`; returns the error message (empty if none). */
+static const char *bad_input(const char *text)
+{
+    last_msg[0] = 0;
+    cfg_set_error_hook(hook);
+    if (setjmp(jb) == 0) {
+        cfg_t *cfg = cfg_load_string("bad.ini", text, 0, NULL);
+        if (cfg) {
+            dem_t *d = dem_create_from_config(cfg, MPI_COMM_WORLD);
+            dem_free(d);
+            cfg_free(cfg);
+        }
+    }
+    cfg_set_error_hook(NULL);
+    return last_msg;
+}
+
 static void test_bad_keys(void **state)
 {
     static const struct {
@@ -113,17 +130,7 @@ static void test_bad_keys(void **state)
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         char text[2048];
         snprintf(text, sizeof text, "%s%s", BOX, cases[k].text);
-        last_msg[0] = 0;
-        cfg_set_error_hook(hook);
-        if (setjmp(jb) == 0) {
-            cfg_t *cfg = cfg_load_string("bad.ini", text, 0, NULL);
-            if (cfg) {
-                dem_t *d = dem_create_from_config(cfg, MPI_COMM_WORLD);
-                dem_free(d);
-                cfg_free(cfg);
-            }
-        }
-        cfg_set_error_hook(NULL);
+        bad_input(text);
         printf("  %-60.60s -> %s\n", cases[k].expect, last_msg);
         assert_non_null(strstr(last_msg, cases[k].expect));
         assert_non_null(strstr(last_msg, "bad.ini"));

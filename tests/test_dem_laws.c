@@ -9,6 +9,11 @@
  *    to e without the clip (the β(e) relation is that of the linear
  *    oscillator); checked within 5 %.  With the clip the restitution is
  *    higher (reported).
+ *  - Moving wall: a wall (infinite mass) moving at V hits a sphere at rest,
+ *    which leaves at (1 + e) V.
+ *  - External force and torque (the immersed boundary's input), held
+ *    constant while sub-cycling with dem_advance: v = F t/m and ω = Γ t/I,
+ *    exact for velocity Verlet under constant forces.
  *  - Rolling resistance: a sphere rolling without slip on a horizontal wall
  *    under a constant resisting torque μ_r R m g decelerates at
  *    (5/7) μ_r g (m a = F, (2/5) m R² α = −F R − μ_r R m g, a = α R).
@@ -113,6 +118,55 @@ static void test_rolling_resistance(void **state)
     dem_free(d);
 }
 
+static void test_moving_wall(void **state)
+{
+    const double V = 0.3, e = 0.87;
+    char text[1024];
+    snprintf(text, sizeof text,
+             "[domain]\nlength = 0.02 0.02 0.02\n[boundary]\nz_lo = noslip\nz_hi = noslip\n[walls]\nfaces = none\n"
+             "wall1_point = 0 0 0.002\nwall1_normal = 0 0 1\nwall1_velocity = 0 0 %g\n"
+             "[contact]\nrestitution = %g\ncontact_time = 1e-4\nfriction = 0.3\n[dem]\ngravity = 0 0 0\n",
+             V, e);
+    cfg_t *cfg = cfg_load_string("piston.ini", text, 0, NULL);
+    assert_non_null(cfg);
+    dem_t *d = dem_create_from_config(cfg, MPI_COMM_WORLD);
+    const double x[3] = {0.01, 0.01, 0.002 + R + 0.37 * V * 2e-6 * 7}, v[3] = {0, 0, 0};
+    dem_add_particle(d, x, v, R, RHO, 0);
+    for (int s = 0; s < 400; s++) assert_int_equal(dem_step(d), DEM_OK);
+    const double vz = dem_velocities(d)[2];
+    double fw[3];
+    dem_wall_force(d, 0, fw);
+    printf("  wall moving at %.2f m/s, e = %.2f: sphere leaves at %.5f m/s, (1 + e) V = %.5f (%+.3f %%)\n", V, e, vz,
+           (1 + e) * V, 100 * (vz / ((1 + e) * V) - 1));
+    /* the restitution test's accuracy at t_c/dt = 50 */
+    assert_true(fabs(vz / ((1 + e) * V) - 1) < 2e-3);
+    assert_true(fw[2] == 0.0); /* separated */
+    dem_free(d);
+    cfg_free(cfg);
+}
+
+static void test_external_force(void **state)
+{
+    dem_t *d = wall_scene("restitution = 0.5\ncontact_time = 1e-4\nfriction = 0.3", 0.0);
+    const double x[3] = {0.01, 0.01, 0.01}, v[3] = {0, 0, 0};
+    dem_add_particle(d, x, v, R, RHO, 0);
+    const double m = dem_mass(d, 0), I = 0.4 * m * R * R;
+    double *fe = dem_ext_force(d), *te = dem_ext_torque(d);
+    fe[0] = 1e-6;
+    te[2] = 1e-10;
+    /* three "fluid steps" of 1.37e-4 s: not a multiple of the DEM step */
+    for (int k = 1; k <= 3; k++) assert_int_equal(dem_advance(d, k * 1.37e-4), DEM_OK);
+    const double t = dem_time(d), vx = dem_velocities(d)[0], wz = dem_omegas(d)[2], xx = dem_positions(d)[0];
+    printf("  external force: t = %.6g s, v = %.6e (F t/m = %.6e), omega = %.6e (T t/I = %.6e), x - x0 = %.6e "
+           "(F t^2/2m = %.6e)\n",
+           t, vx, 1e-6 * t / m, wz, 1e-10 * t / I, xx - 0.01, 0.5e-6 * t * t / m);
+    assert_true(fabs(t - 3 * 1.37e-4) < 1e-15);
+    assert_true(fabs(vx / (1e-6 * t / m) - 1) < 1e-12);
+    assert_true(fabs(wz / (1e-10 * t / I) - 1) < 1e-12);
+    assert_true(fabs((xx - 0.01) / (0.5e-6 * t * t / m) - 1) < 1e-8);
+    dem_free(d);
+}
+
 int main(int argc, char **argv)
 {
     test_mpi_init(&argc, &argv);
@@ -121,6 +175,8 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_hertz_elastic),
         cmocka_unit_test(test_hertz_damped),
         cmocka_unit_test(test_rolling_resistance),
+        cmocka_unit_test(test_moving_wall),
+        cmocka_unit_test(test_external_force),
     };
     TEST_MPI_RUN("dem_laws", tests);
 }

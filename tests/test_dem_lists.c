@@ -9,8 +9,8 @@
  *  - After many steps with rebuilds and reordering, the contacts the force
  *    loop finds are exactly the overlapping pairs of the brute-force search.
  *  - A rebuild with reordering keeps every contact's tangential spring.
- *  - Same input, same ranks: bit-identical; pairs split over 2 ranks agree
- *    with the serial computation to round-off.
+ *  - Same input, same ranks: bit-identical; pairs split over 2 ranks (or
+ *    2 OpenMP threads) agree with the serial computation to round-off.
  */
 #include <stdlib.h>
 #include <string.h>
@@ -246,6 +246,34 @@ static void test_split_momentum(void **state)
     dem_free(d);
 }
 
+/* OpenMP threads: two runs with 2 threads are bit-identical, and agree with
+ * the serial run to round-off. */
+static void test_threads(void **state)
+{
+    const char *bnd = "z_lo = noslip\nz_hi = noslip";
+    dem_t *a = scene("0.012 0.012 0.012", bnd, 95, 0.3, "parallel = replicated", MPI_COMM_SELF, -981.0);
+    dem_t *b = scene("0.012 0.012 0.012", bnd, 95, 0.3, "parallel = replicated\nthreads = 2", MPI_COMM_SELF, -981.0);
+    dem_t *c = scene("0.012 0.012 0.012", bnd, 95, 0.3, "parallel = replicated\nthreads = 2", MPI_COMM_SELF, -981.0);
+    for (int s = 0; s < 3000; s++) {
+        assert_int_equal(dem_step(a), DEM_OK);
+        assert_int_equal(dem_step(b), DEM_OK);
+        assert_int_equal(dem_step(c), DEM_OK);
+    }
+    double dmax = 0;
+    int same = 1;
+    for (int i = 0; i < dem_count(a); i++)
+        for (int q = 0; q < 3; q++) {
+            dmax = fmax(dmax, fabs(dem_positions(b)[3 * i + q] - dem_positions(a)[3 * i + q]));
+            same &= dem_positions(b)[3 * i + q] == dem_positions(c)[3 * i + q];
+        }
+    printf("  2 threads: runs bit-identical: %s; against 1 thread: max |dx| = %.2e m\n", same ? "yes" : "no", dmax);
+    assert_true(same);
+    assert_true(dmax < 1e-12);
+    dem_free(a);
+    dem_free(b);
+    dem_free(c);
+}
+
 int main(int argc, char **argv)
 {
     test_mpi_init(&argc, &argv);
@@ -257,6 +285,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_history_kept),
         cmocka_unit_test(test_reproducible_and_split),
         cmocka_unit_test(test_split_momentum),
+        cmocka_unit_test(test_threads),
     };
     TEST_MPI_RUN("dem_lists", tests);
 }

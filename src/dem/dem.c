@@ -141,6 +141,10 @@ void dem_free(dem_t *d)
                    d->r, d->invm, d->invI, d->rho, d->id, d->fixed};
     for (size_t a = 0; a < sizeof arr / sizeof arr[0]; a++) free(arr[a]);
     free(d->kernel_block);
+    for (int q = 0; q < DEM_MAX_THREADS; q++) {
+        free(d->tblock[q]);
+        free(d->tforce[q]);
+    }
     free(d->snap_t);
     free(d->snap_n);
     free(d->snap_index);
@@ -213,7 +217,15 @@ void dem_decide_split(dem_t *d)
 void dem_compute_forces(dem_t *d)
 {
     double t0 = wtime();
-    if (!d->kernel_block) d->kernel_block = xcalloc(1, DEM_KERNEL_BLOCK_BYTES);
+    if (d->nthreads < 1) d->nthreads = 1;
+    for (int q = 0; q < d->nthreads; q++) {
+        if (!d->tblock[q]) d->tblock[q] = xcalloc(1, DEM_KERNEL_BLOCK_BYTES);
+        if (q > 0 && d->tforce_cap < d->cap) {
+            free(d->tforce[q]);
+            d->tforce[q] = xcalloc(6 * (size_t)d->cap, sizeof(double));
+        }
+    }
+    if (d->tforce_cap < d->cap) d->tforce_cap = d->cap;
     memset(d->f, 0, 3 * (size_t)d->n * sizeof(double));
     memset(d->t, 0, 3 * (size_t)d->n * sizeof(double));
     d->n_contacts = d->n_wall_contacts = 0;
@@ -267,6 +279,7 @@ static double kick_drift(dem_t *d)
     double vmax2 = 0.0;
     if (d->use_ext) {
         const double *restrict fe = d->fext, *restrict te = d->text;
+#pragma omp parallel for num_threads(d->nthreads) if (d->nthreads > 1) reduction(max : vmax2) schedule(static)
         for (int i = 0; i < n; i++) {
             if (fixed[i]) continue;
             const double im = invm[i], ii = invI[i];
@@ -285,6 +298,7 @@ static double kick_drift(dem_t *d)
             if (v2 > vmax2) vmax2 = v2;
         }
     } else {
+#pragma omp parallel for num_threads(d->nthreads) if (d->nthreads > 1) reduction(max : vmax2) schedule(static)
         for (int i = 0; i < n; i++) {
             if (fixed[i]) continue;
             const double im = h * invm[i], ii = h * invI[i];
@@ -319,6 +333,7 @@ void dem_sync_velocities(dem_t *d)
 {
     if (!d->pending_kick) return;
     const double h = 0.5 * d->dt;
+#pragma omp parallel for num_threads(d->nthreads) if (d->nthreads > 1) schedule(static)
     for (int i = 0; i < d->n; i++) {
         if (d->fixed[i]) continue;
         const double im = h * d->invm[i], ii = h * d->invI[i];

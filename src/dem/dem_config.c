@@ -94,6 +94,9 @@ static const cfg_key_t dem_keys[] = {
     {"dem", "skin", CFG_DOUBLE, "0.1", 1e-4, 2, NULL, "Verlet skin as a fraction of the largest diameter"},
     {"dem", "sort_every", CFG_INT, "1", 0, 1000000, NULL,
      "reorder the particles by cell every this many list rebuilds (0: never)"},
+    {"dem", "threads", CFG_INT, "1", 1, 64, NULL,
+     "OpenMP threads per rank for the pair forces and the integration (each thread sums into its own force "
+     "array; same thread count: same result)"},
     {"dem", "parallel", CFG_ENUM, "auto", 1, 0, "auto|replicated|split",
      "several ranks: every rank computes everything (replicated), or the pairs are shared and the forces summed "
      "(split); auto: split from 4000 particles"},
@@ -524,6 +527,10 @@ dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
     d->sort_every = cfg_int(cfg, "dem", "sort_every");
     d->max_overlap_allowed = cfg_double(cfg, "dem", "max_overlap");
     d->parallel_mode = cfg_enum(cfg, "dem", "parallel");
+    d->nthreads = cfg_int(cfg, "dem", "threads");
+#ifndef _OPENMP
+    if (d->nthreads > 1) cfg_fail(cfg, "dem", "threads", "this build has no OpenMP (compile src/dem with -fopenmp)");
+#endif
     d->hist_update = 1;
     config_walls(d, cfg);
     const int src = cfg_enum(cfg, "particles", "source");

@@ -88,7 +88,27 @@ static void partition_of(const dem_t *d, int q, int *lo, int *hi)
     *hi = bounds[1];
 }
 
-void dem_neigh_partition(dem_t *d) { partition_of(d, d->rank, &d->row_lo, &d->row_hi); }
+void dem_neigh_partition(dem_t *d)
+{
+    partition_of(d, d->rank, &d->row_lo, &d->row_hi);
+    /* the threads' shares of the rank's rows, balanced by pair count */
+    const int nt = d->nthreads > 0 ? d->nthreads : 1;
+    const long p0 = d->nb_start ? d->nb_start[d->row_lo] : 0, p1 = d->nb_start ? d->nb_start[d->row_hi] : 0;
+    d->trow[0] = d->row_lo;
+    d->trow[nt] = d->row_hi;
+    for (int q = 1; q < nt; q++) {
+        const long target = p0 + (p1 - p0) * q / nt;
+        int a = d->trow[q - 1], z = d->row_hi;
+        while (a < z) {
+            const int mid = (a + z) / 2;
+            if (d->nb_start[mid] < target)
+                a = mid + 1;
+            else
+                z = mid;
+        }
+        d->trow[q] = a;
+    }
+}
 
 /* Every rank updated the histories of its own rows only: share them. */
 void dem_neigh_gather(dem_t *d)

@@ -14,6 +14,7 @@
 
 #define DEM_MAX_WALLS 16
 #define DEM_MAX_USER_WALLS 6
+#define DEM_MAX_THREADS 64
 /* bytes of the pair loop's work space: 128 contacts × (3 ints + 38 doubles) */
 #define DEM_KERNEL_BLOCK_BYTES (128 * (3 * sizeof(int) + 40 * sizeof(double)))
 
@@ -132,7 +133,14 @@ struct dem {
     long nb_n, nb_cap;
     int nb_n_rows;       /* particles (rows) covered by the list */
     double shift[27][3];
-    void *kernel_block;  /* work space of the pair loop (dem_kernel.inc) */
+    void *kernel_block;  /* work space of the pair loop (dem_kernel.inc), one per thread: */
+    void *tblock[DEM_MAX_THREADS];
+    /* threads (OpenMP, [dem] threads): rows [trow[t], trow[t+1]) of the
+     * rank's share; force and torque arrays of threads 1.. (6n each) */
+    int nthreads;
+    int trow[DEM_MAX_THREADS + 1];
+    double *tforce[DEM_MAX_THREADS];
+    int tforce_cap;
     /* the rank's share: rows [row_lo, row_hi) of the list */
     int row_lo, row_hi;
 
