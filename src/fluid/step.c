@@ -10,7 +10,8 @@
  *            problem (L − λ) u* = −λ rhs − (wall terms), λ = 2/(α_k Δt ν)]
  *   stage hook (immersed boundary) on u*
  *   L φ   = D u* / (α_k Δt),   u^k = u* − α_k Δt G φ,
- *   p^k   = p^{k−1} + φ  [− α_k Δt ν/2 L φ when Crank–Nicolson].
+ *   p^k   = p^{k−1} + φ  [− α_k Δt ν/2 L φ when Crank–Nicolson],
+ *   stage-end hook (immersed boundary: particle update) on u^k.
  * Since L = D·G (poisson.c), D u^k = 0 to the solver's round-off.
  */
 #include <math.h>
@@ -18,8 +19,8 @@
 #include "fluid_internal.h"
 #include "util.h"
 
-static const double rk_gamma[3] = {8.0 / 15.0, 5.0 / 12.0, 3.0 / 4.0};
-static const double rk_zeta[3] = {0.0, -17.0 / 60.0, -5.0 / 12.0};
+const double fluid_rk_gamma[3] = {8.0 / 15.0, 5.0 / 12.0, 3.0 / 4.0};
+const double fluid_rk_zeta[3] = {0.0, -17.0 / 60.0, -5.0 / 12.0};
 
 /* Stride and inverse spacing of the gradient of a cell-centred field at the
  * unknowns of component c (x: per i). */
@@ -101,6 +102,8 @@ void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, doubl
     fluid_apply_bc(f);
 }
 
+void fluid_stage_project(fluid_t *f, double dt_stage) { fluid_project_stage(f, dt_stage, 1, NULL); }
+
 void fluid_project(fluid_t *f)
 {
     fluid_apply_bc(f);
@@ -131,14 +134,14 @@ void fluid_step(fluid_t *f, double dt)
     int nc = fluid_ncomp(g);
     double stats[2] = {0.0, 0.0};
     for (int s = 0; s < 3; s++) {
-        double adt = (rk_gamma[s] + rk_zeta[s]) * dt;
+        double adt = (fluid_rk_gamma[s] + fluid_rk_zeta[s]) * dt;
         /* H^k = −∇·(u⊗u) [+ νLu] from u^{k−1} (its ghosts are valid: every
          * stage ends with them) into spare, and the predictor
          * u* = u^{k−1} + Δt(γH^k + ζH^{k−1}) + αΔt(f − G p) [+ αΔtν/2 L u^{k−1}]
          * over h (which held H^{k−1}), in one sweep; then rotate:
          * u ← u*, h ← H^k, spare ← u^{k−1} (free). */
         int impl = f->prm.implicit_viscous;
-        fluid_rhs_predict(f, -1.0, impl ? 0.0 : f->prm.nu, dt * rk_gamma[s], dt * rk_zeta[s], adt,
+        fluid_rhs_predict(f, -1.0, impl ? 0.0 : f->prm.nu, dt * fluid_rk_gamma[s], dt * fluid_rk_zeta[s], adt,
                           impl ? 0.5 * adt * f->prm.nu : 0.0, q->spare, q->h);
         for (int c = 0; c < nc; c++) {
             double *old = f->u[c];
@@ -154,6 +157,7 @@ void fluid_step(fluid_t *f, double dt)
             fluid_apply_bc(f);
         }
         fluid_project_stage(f, adt, 1, s == 2 ? stats : NULL);
+        if (f->stage_end_hook) f->stage_end_hook(f, s, adt, f->hook_ctx);
     }
     f->time += dt;
     f->step++;
