@@ -42,29 +42,38 @@ void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, doubl
     f->diag.it_poisson = q->pp->last_iterations;
     fluid_fill_pressure_ghosts(f, phi);
     /* u −= α Δt G φ; with `stats`, also accumulate Σ V u² (stats[0]) and
-     * max |u| (stats[1]) of the projected field for the diagnostics */
+     * max |u| (stats[1]) of the projected field for the diagnostics.  With
+     * explicit viscous terms the pressure update p += φ is done in the same
+     * sweep as u (whose unknowns are the pressure cells, except the plane
+     * beyond an x wall, done below), while the line of φ is still in cache. */
+    int fuse_p = update_pressure && !f->prm.implicit_viscous;
     for (int c = 0; c < fluid_ncomp(g); c++) {
         double *restrict u = f->u[c];
+        double *restrict pp = c == 0 && fuse_p ? f->p : NULL;
         const double *restrict ph = phi;
         long sp = grad_stride(g, c);
         int iend = fluid_iend(g, c), nj = fluid_nu(g, c, 1), nk = fluid_nu(g, c, 2);
         for (int i = 0; i < iend; i++) {
             double a = dt_stage * grad_rdx(g, c, i);
-            if (!stats) {
-                FLUID_FOR_LINES(g, i, nj, nk, c0, len)
-                for (long m = c0; m < c0 + len; m++) u[m] -= a * (ph[m + sp] - ph[m]);
-                continue;
-            }
-            double e = 0.0, um = stats[1];
+            double e = 0.0, um = stats ? stats[1] : 0.0;
             FLUID_FOR_LINES(g, i, nj, nk, c0, len)
-            for (long m = c0; m < c0 + len; m++) {
-                double x = u[m] - a * (ph[m + sp] - ph[m]);
-                u[m] = x;
-                e += x * x;
-                um = dmax(um, fabs(x));
+            {
+                if (!stats)
+                    for (long m = c0; m < c0 + len; m++) u[m] -= a * (ph[m + sp] - ph[m]);
+                else
+                    for (long m = c0; m < c0 + len; m++) {
+                        double x = u[m] - a * (ph[m + sp] - ph[m]);
+                        u[m] = x;
+                        e += x * x;
+                        um = dmax(um, fabs(x));
+                    }
+                if (pp)
+                    for (long m = c0; m < c0 + len; m++) pp[m] += ph[m];
             }
-            stats[0] += fluid_cell_volume(f, c, i) * e;
-            stats[1] = um;
+            if (stats) {
+                stats[0] += fluid_cell_volume(f, c, i) * e;
+                stats[1] = um;
+            }
         }
     }
     if (update_pressure) {
@@ -92,7 +101,8 @@ void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, doubl
                 }
             }
         } else {
-            for (int i = 0; i < g->nxl; i++)
+            /* p += φ on the planes the sweep of u above did not cover */
+            for (int i = fluid_iend(g, 0); i < g->nxl; i++)
                 FLUID_FOR_LINES(g, i, g->n[1], g->n[2], c0, len)
                 for (long m = c0; m < c0 + len; m++) f->p[m] += phi[m];
         }
