@@ -167,10 +167,12 @@ void fluid_step(fluid_t *f, double dt)
          * stage ends with them) into spare, and the predictor
          * u* = u^{k−1} + Δt(γH^k + ζH^{k−1}) + αΔt(f − G p) [+ αΔtν/2 L u^{k−1}]
          * over h (which held H^{k−1}), in one sweep; then rotate:
-         * u ← u*, h ← H^k, spare ← u^{k−1} (free). */
+         * u ← u*, h ← H^k, spare ← u^{k−1} (free).  The last stage's H is
+         * not needed (ζ_1 = 0: the first stage of the next step does not
+         * read H_old), so it is not stored. */
         int impl = f->prm.implicit_viscous;
         fluid_rhs_predict(f, -1.0, impl ? 0.0 : f->prm.nu, dt * rk_gamma[s], dt * rk_zeta[s], adt,
-                          impl ? 0.5 * adt * f->prm.nu : 0.0, q->spare, q->h);
+                          impl ? 0.5 * adt * f->prm.nu : 0.0, s < 2 ? q->spare : NULL, q->h);
         for (int c = 0; c < nc; c++) {
             double *old = f->u[c];
             f->u[c] = q->h[c];
