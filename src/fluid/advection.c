@@ -169,27 +169,26 @@ static void line_coefs(const fluid_t *f, int c, int i, double adt, coef_t *k)
 /* Each line kernel instantiated with constant flags (is3d_, fused_, hold_,
  * hstore_) for the modes used: the right-hand side alone, and the fused
  * predictor of the first (no H_old), middle and last (H not kept) stages. */
-#define LINE_VARIANTS_3D(fn, args)                                                                  \
-    do {                                                                                            \
-        const int is3d_ = 1;                                                                        \
-        (void)is3d_;                                                                                \
-        if (!fused) { const int fused_ = 0, hold_ = 0, hstore_ = 1; fn args; }                     \
-        else if (!hold) { const int fused_ = 1, hold_ = 0, hstore_ = 1; fn args; }                 \
-        else if (hstore) { const int fused_ = 1, hold_ = 1, hstore_ = 1; fn args; }                \
-        else { const int fused_ = 1, hold_ = 1, hstore_ = 0; fn args; }                            \
+#define LINE_VARIANTS_MODES(fn, args)                                                           \
+    do {                                                                                        \
+        if (!fused) { const int fused_ = 0, hold_ = 0, hstore_ = 1; fn args; }                 \
+        else if (!hold) { const int fused_ = 1, hold_ = 0, hstore_ = 1; fn args; }             \
+        else if (hstore) { const int fused_ = 1, hold_ = 1, hstore_ = 1; fn args; }            \
+        else { const int fused_ = 1, hold_ = 1, hstore_ = 0; fn args; }                        \
     } while (0)
-#define LINE_VARIANTS_2D(fn, args)                                                                  \
-    do {                                                                                            \
-        const int is3d_ = 0;                                                                        \
-        if (!fused) { const int fused_ = 0, hold_ = 0, hstore_ = 1; fn args; }                     \
-        else if (!hold) { const int fused_ = 1, hold_ = 0, hstore_ = 1; fn args; }                 \
-        else if (hstore) { const int fused_ = 1, hold_ = 1, hstore_ = 1; fn args; }                \
-        else { const int fused_ = 1, hold_ = 1, hstore_ = 0; fn args; }                            \
+#define LINE_VARIANTS_3D(fn, args)          \
+    do {                                    \
+        const int is3d_ = 1;                \
+        (void)is3d_;                        \
+        LINE_VARIANTS_MODES(fn, args);      \
     } while (0)
-#define LINE_VARIANTS(fn, args)                      \
-    do {                                             \
-        if (is3d) LINE_VARIANTS_3D(fn, args);        \
-        else LINE_VARIANTS_2D(fn, args);             \
+#define LINE_VARIANTS(fn, args)                  \
+    do {                                         \
+        if (is3d) LINE_VARIANTS_3D(fn, args);    \
+        else {                                   \
+            const int is3d_ = 0;                 \
+            LINE_VARIANTS_MODES(fn, args);       \
+        }                                        \
     } while (0)
 
 /* One sweep over the unknowns of every component: H[c] = ca·N_c + cv·L u_c
