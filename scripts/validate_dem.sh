@@ -44,7 +44,7 @@ fi
 section "dem: dry flow on a rough inclined plane, 3300 grains, 24 deg"
 d=$OUT/dem_incline
 rm -rf "$d"
-if $MPIRUN -np 2 "$BUILD/ibmdem" run cases/dem_inclined_plane/case.ini --out "$d" &&
+if $MPIRUN -np 1 "$BUILD/ibmdem" run cases/dem_inclined_plane/case.ini --out "$d" &&
    $PY postproc/dem_incline.py "$d" 3 4 0.005 "$d/incline.png"; then
     $PY - "$d" <<'EOF' || fail "dem inclined plane"
 import json, sys
