@@ -15,8 +15,15 @@ typedef struct fluid fluid_t;
 
 /* Called at every Runge–Kutta stage after the predictor and before the
  * projection (the immersed-boundary forcing lives here): may modify the
- * predicted velocity u*.  dt_stage = (γ_k + ζ_k) Δt. */
+ * predicted velocity u*.  dt_stage = (γ_k + ζ_k) Δt.  The same type serves
+ * the stage-end hook, called after the projection of every stage (u^k
+ * divergence-free, ghosts filled): the immersed boundary measures the fluid
+ * momentum inside the particles there and moves them. */
 typedef void (*fluid_stage_hook_t)(fluid_t *f, int stage, double dt_stage, void *ctx);
+
+/* Coefficients of the low-storage RK3 (step.c): stage k advances by
+ * (γ_k + ζ_k) Δt, i.e. to t + (8/15, 2/3, 1) Δt. */
+extern const double fluid_rk_gamma[3], fluid_rk_zeta[3];
 
 typedef struct {
     double nu;            /* kinematic viscosity */
@@ -49,8 +56,9 @@ struct fluid {
     double time;
     long step;
     fluid_diag_t diag;
-    fluid_stage_hook_t stage_hook;
-    void *hook_ctx;
+    fluid_stage_hook_t stage_hook;     /* before each projection (may be NULL) */
+    fluid_stage_hook_t stage_end_hook; /* after each projection (may be NULL) */
+    void *hook_ctx;                    /* passed to both hooks */
     void *priv;           /* work arrays and solvers of the implementation */
 };
 
@@ -66,6 +74,10 @@ void fluid_init_from_config(fluid_t *f, cfg_t *cfg);
 /* Remove the gradient part of u (projection without a pressure update), e.g.
  * after setting an initial field; fills the ghosts. */
 void fluid_project(fluid_t *f);
+/* From a stage hook: project the current u* as the end of the stage does
+ * (the pressure gets the correction too), e.g. between forcing iterations;
+ * the stage's own projection still follows the hook.  Fills the ghosts. */
+void fluid_stage_project(fluid_t *f, double dt_stage);
 void fluid_free(fluid_t *f);
 
 /* Fill the ghost values of the velocity (walls, axis, periodic, halos). */

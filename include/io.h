@@ -79,7 +79,9 @@ void io_h5_write_cells_xfast(hid_t loc, const char *name, const grid_t *g, int n
 
 /* Small arrays and attributes: every rank passes the same values. */
 void io_h5_write_array(hid_t loc, const char *name, long n, const double *v);
-/* Returns the length read (<= nmax), or -1 if missing. */
+/* A row-major [n][m] array (e.g. particle positions [n][3]). */
+void io_h5_write_matrix(hid_t loc, const char *name, long n, int m, const double *v);
+/* Returns the number of values read (<= nmax; n×m for a matrix), or -1 if missing. */
 long io_h5_read_array(hid_t loc, const char *name, long nmax, double *v);
 void io_h5_write_text(hid_t loc, const char *name, const char *text);
 char *io_h5_read_text(hid_t loc, const char *name); /* malloc'd; NULL if missing */

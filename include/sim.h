@@ -27,7 +27,7 @@
 #include "io.h"
 
 #define SIM_MAX_PARTS 8
-#define SIM_MAX_COLS 64
+#define SIM_MAX_COLS 96
 
 typedef struct sim sim_t;
 
@@ -81,6 +81,11 @@ typedef struct {
     int progress;          /* progress line: 0 auto, 1 on, 2 off (io_progress_start) */
 } sim_params_t;
 
+/* A part that adds cell fields to the fluid's snapshots (e.g. the solid
+ * fraction of the immersed boundary): called between io_snapshot_begin and
+ * io_snapshot_end of every snapshot. */
+typedef void (*sim_field_writer_t)(void *ctx, io_snapshots_t *snap);
+
 typedef enum { SIM_RUNNING = 0, SIM_T_END, SIM_MAX_STEPS, SIM_WALL_LIMIT, SIM_STEADY, SIM_DIVERGED } sim_status_t;
 
 struct sim {
@@ -89,6 +94,10 @@ struct sim {
     sim_params_t prm;
     sim_part_t part[SIM_MAX_PARTS];
     int npart;
+    struct fluid *fluid;     /* the scene's fluid (sim_add_fluid), NULL without [fluid] */
+    sim_field_writer_t field_writer[SIM_MAX_PARTS]; /* extra fields of the fluid snapshots */
+    void *field_writer_ctx[SIM_MAX_PARTS];
+    int nfield_writers;
     /* state */
     double time, dt;
     long step;
@@ -130,6 +139,9 @@ void sim_free(sim_t *s);
  * skips them): run control and outputs. */
 extern const char *const sim_run_control_keys[];
 
+/* Add cell fields to the fluid's snapshots (see sim_field_writer_t). */
+void sim_add_field_writer(sim_t *s, sim_field_writer_t fn, void *ctx);
+
 /* The fluid part (sim_fluid.c): built when the case has a [fluid] section. */
 void sim_add_fluid(sim_t *s, cfg_t *cfg);
 /* The DEM part (sim_dem.c): built when the case has a [particles] section. */
@@ -138,5 +150,8 @@ void sim_add_dem(sim_t *s, cfg_t *cfg);
 struct dem *sim_dem_engine(sim_t *s);
 /* The pore-network fluid (sim_porenet.c): built when the case has a [porenet] section. */
 void sim_add_porenet(sim_t *s, cfg_t *cfg);
+/* The immersed-boundary part (sim_ibm.c): built when the case has an [ibm]
+ * section; needs the fluid (its stage hooks do the work). */
+void sim_add_ibm(sim_t *s, cfg_t *cfg);
 
 #endif

@@ -102,6 +102,23 @@ cat "$OUT/fluid_cavity.txt"
 section "dem: column collapse and inclined plane (full size)"
 BUILD=$BUILD OUT=$OUT bash scripts/validate_dem.sh || fail "dem cases"
 
+
+# --- ibm: the immersed boundary at full size (tests/test_ibm_*.c in their full modes).
+#  1. the settling sphere of the seed, axisymmetric, D/dx = 20, r <= 10 D, 40 D long,
+#     dt sqrt(g/D) = 0.04: initial acceleration within 5 % of (rho_p - rho) g/(rho_p + rho/2),
+#     terminal velocity within 3 % of Schiller-Naumann;
+#  2. Stokes drag of a simple cubic array against Hasimoto (1959) at D/dx = 8, 12, 16, 24
+#     (order of convergence printed and > 0.8) and the torque on a rotating sphere at
+#     D/dx = 16 within 5 % of 8 pi mu a^3 Omega;
+#  3. the settling sphere in 3-D at D/dx = 16 in a free-slip box of 6 x 24 x 6 D, corrected for
+#     the box with the axisymmetric solver (same cross-section area against r = 10 D): within 5 %.
+section "ibm: settling sphere, axisymmetric, D/dx = 20"
+IBM_FULL=1 IBM_TESTS=test_settling_full $MPIRUN -np 2 "$BUILD/tests/test_ibm_settling" || fail "ibm settling D/dx = 20"
+section "ibm: Stokes drag D/dx = 8..24 and torque D/dx = 16"
+IBM_FULL=1 $MPIRUN -np 2 "$BUILD/tests/test_ibm_stokes" || fail "ibm Stokes drag and torque"
+section "ibm: settling sphere, 3-D, D/dx = 16"
+IBM_FULL3D=1 IBM_TESTS=test_settling_3d $MPIRUN -np 2 "$BUILD/tests/test_ibm_settling" || fail "ibm settling 3-D"
+
 # (further modules: add sections here)
 
 echo

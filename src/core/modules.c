@@ -3,6 +3,7 @@
 
 #include "dem.h"
 #include "fluid.h"
+#include "ibm.h"
 #include "grid.h"
 #include "poisson.h"
 #include "porenet.h"
@@ -14,6 +15,7 @@ void modules_register_keys(void)
     poisson_register_keys();
     fluid_register_keys();
     porenet_register_keys();
+    ibm_register_keys();
     sim_register_keys();
     dem_register_keys();
 }

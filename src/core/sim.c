@@ -82,6 +82,13 @@ void sim_add_part(sim_t *s, const sim_part_t *part)
     s->part[s->npart++] = *part;
 }
 
+void sim_add_field_writer(sim_t *s, sim_field_writer_t fn, void *ctx)
+{
+    if (s->nfield_writers == SIM_MAX_PARTS) die("too many snapshot field writers (SIM_MAX_PARTS = %d)", SIM_MAX_PARTS);
+    s->field_writer[s->nfield_writers] = fn;
+    s->field_writer_ctx[s->nfield_writers++] = ctx;
+}
+
 /* ---- checkpoints --------------------------------------------------------- */
 
 static void write_checkpoint(sim_t *s)
@@ -149,9 +156,12 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
 
     /* Parts of the scene, in the order they advance. */
     if (cfg_has_section(cfg, "fluid")) sim_add_fluid(s, cfg);
+    if (cfg_has_section(cfg, "ibm")) {
+        if (!s->fluid) cfg_fail(cfg, "ibm", "sphere1", "an immersed boundary needs a fluid: the case has no [fluid] section");
+        sim_add_ibm(s, cfg);
+    }
     if (cfg_has_section(cfg, "particles")) sim_add_dem(s, cfg);
     if (cfg_has_section(cfg, "porenet")) sim_add_porenet(s, cfg);
-    /* (immersed boundary coupling: add here) */
 
     if (s->npart == 0) {
         if (mpi_rank() == 0) fprintf(stderr, "%s: nothing to simulate: the case has no [fluid] or [particles] section (with at least one key)\n", cfg_path(cfg));
@@ -424,7 +434,9 @@ int sim_run(sim_t *s)
 void sim_free(sim_t *s)
 {
     if (!s) return;
-    for (int i = 0; i < s->npart; i++)
+    /* in reverse order of creation: a part may use an earlier one (the
+     * immersed boundary holds the fluid) */
+    for (int i = s->npart - 1; i >= 0; i--)
         if (s->part[i].destroy) s->part[i].destroy(s->part[i].ctx);
     io_series_close(s->series);
     io_summary_free(s->summary);

@@ -150,6 +150,7 @@ static void part_write_fields(void *ctx, double time, long step)
     io_snapshot_begin(fp->snaps, time, step);
     io_snapshot_cell_scalar(fp->snaps, "pressure", fp->f->p);
     io_snapshot_face_vector(fp->snaps, "velocity", fp->f->u);
+    for (int w = 0; w < fp->sim->nfield_writers; w++) fp->sim->field_writer[w](fp->sim->field_writer_ctx[w], fp->snaps);
     io_snapshot_end(fp->snaps);
 }
 
@@ -264,6 +265,7 @@ void sim_add_fluid(sim_t *s, cfg_t *cfg)
     fluid_apply_bc(fp->f);
     fp->ke_now = fluid_kinetic_energy(fp->f);
     fp->div_init = fluid_max_divergence(fp->f);
+    s->fluid = fp->f;
     sim_part_t part = {
         .name = "fluid",
         .ctx = fp,

@@ -50,16 +50,23 @@ typedef struct {
     const double *p;
 } stage_t;
 
-#define PREDICT(Hd, US, m, h, Lu, sp)                                                                     \
-    do {                                                                                                  \
-        Hd[m] = h;                                                                                        \
-        if (fused) US[m] = q0 + st->dg * h + st->dz * US[m] + k->af - k->ag * (p[m + sp] - p[m]) + st->ce * Lu; \
+/* `hstore`: H is kept for the next stage (not after the last one); `hold`:
+ * the predictor has a ζ H_old term (not in the first stage, ζ_1 = 0, where
+ * H_old is not read).  Dropping them saves three streams over memory each. */
+#define PREDICT(Hd, US, m, h, Lu, sp)                                                         \
+    do {                                                                                      \
+        if (hstore) Hd[m] = h;                                                                \
+        if (fused) {                                                                          \
+            double s_ = q0 + st->dg * h;                                                      \
+            if (hold) s_ += st->dz * US[m];                                                   \
+            US[m] = s_ + k->af - k->ag * (p[m + sp] - p[m]) + st->ce * Lu;                    \
+        }                                                                                     \
     } while (0)
 
 /* u-momentum: control volume a_f,i Δx_c,i × Δy × Δz around face i. */
 KERNEL u_line(const double *restrict u, const double *restrict v, const double *restrict w, double *restrict Hd,
               double *restrict US, long c0, long len, long sx, long sy, double rdy, double rdz, const coef_t *k,
-              const stage_t *st, int is3d, int fused)
+              const stage_t *st, int is3d, int fused, int hold, int hstore)
 {
     const double *restrict p = st->p;
     for (long c = c0; c < c0 + len; c++) {
@@ -83,7 +90,7 @@ KERNEL u_line(const double *restrict u, const double *restrict v, const double *
 /* v-momentum: control volume a_c,i Δx_f,i × Δy × Δz around y-face j. */
 KERNEL v_line(const double *restrict u, const double *restrict v, const double *restrict w, double *restrict Hd,
               double *restrict US, long c0, long len, long sx, long sy, double rdy, double rdz, const coef_t *k,
-              const stage_t *st, int is3d, int fused)
+              const stage_t *st, int is3d, int fused, int hold, int hstore)
 {
     const double *restrict p = st->p;
     for (long c = c0; c < c0 + len; c++) {
@@ -107,7 +114,7 @@ KERNEL v_line(const double *restrict u, const double *restrict v, const double *
 /* w-momentum (3-D only): control volume Δx_f,i × Δy × Δz around z-face k. */
 KERNEL w_line(const double *restrict u, const double *restrict v, const double *restrict w, double *restrict Hd,
               double *restrict US, long c0, long len, long sx, long sy, double rdy, double rdz, const coef_t *k,
-              const stage_t *st, int fused)
+              const stage_t *st, int fused, int hold, int hstore)
 {
     const double *restrict p = st->p;
     for (long c = c0; c < c0 + len; c++) {
@@ -159,9 +166,35 @@ static void line_coefs(const fluid_t *f, int c, int i, double adt, coef_t *k)
     k->af = adt * f->prm.body_force[c];
 }
 
-/* One sweep over the unknowns of every component: H[c] = ca·N_c + cv·L u_c,
- * and when US is given the predictor u* written over US[c] (= H_old on
- * entry).  Ghosts of u must be valid. */
+/* Each line kernel instantiated with constant flags (is3d_, fused_, hold_,
+ * hstore_) for the modes used: the right-hand side alone, and the fused
+ * predictor of the first (no H_old), middle and last (H not kept) stages. */
+#define LINE_VARIANTS_MODES(fn, args)                                                           \
+    do {                                                                                        \
+        if (!fused) { const int fused_ = 0, hold_ = 0, hstore_ = 1; fn args; }                 \
+        else if (!hold) { const int fused_ = 1, hold_ = 0, hstore_ = 1; fn args; }             \
+        else if (hstore) { const int fused_ = 1, hold_ = 1, hstore_ = 1; fn args; }            \
+        else { const int fused_ = 1, hold_ = 1, hstore_ = 0; fn args; }                        \
+    } while (0)
+#define LINE_VARIANTS_3D(fn, args)          \
+    do {                                    \
+        const int is3d_ = 1;                \
+        (void)is3d_;                        \
+        LINE_VARIANTS_MODES(fn, args);      \
+    } while (0)
+#define LINE_VARIANTS(fn, args)                  \
+    do {                                         \
+        if (is3d) LINE_VARIANTS_3D(fn, args);    \
+        else {                                   \
+            const int is3d_ = 0;                 \
+            LINE_VARIANTS_MODES(fn, args);       \
+        }                                        \
+    } while (0)
+
+/* One sweep over the unknowns of every component: H[c] = ca·N_c + cv·L u_c
+ * (unless H is NULL), and when US is given the predictor u* written over
+ * US[c] (= H_old on entry, read only when st->dz ≠ 0).  Ghosts of u must be
+ * valid. */
 static void rhs_sweep(const fluid_t *f, const stage_t *st, double adt, double *const H[3], double *const US[3])
 {
     const grid_t *g = f->g;
@@ -169,6 +202,7 @@ static void rhs_sweep(const fluid_t *f, const stage_t *st, double adt, double *c
     long sx = g->sx, sy = g->sy;
     double rdy = 1.0 / g->dy, rdz = g->dim == 3 ? 1.0 / g->dz : 0.0;
     int is3d = g->dim == 3, fused = US != NULL, nc = fluid_ncomp(g);
+    int hold = fused && st->dz != 0.0, hstore = H != NULL;
     int iend[3], nj[3], nk[3];
     for (int c = 0; c < nc; c++) {
         iend[c] = fluid_iend(g, c);
@@ -185,20 +219,13 @@ static void rhs_sweep(const fluid_t *f, const stage_t *st, double adt, double *c
             for (int c = 0; c < nc; c++) {
                 if (i >= iend[c] || (is3d && jl >= nj[c])) continue;
                 long c0 = G_IDX(g, i, jl, 0), len = is3d ? nk[c] : nj[c];
-                if (c == 0) {
-                    if (is3d && fused) u_line(u, v, w, H[0], us[0], c0, len, sx, sy, rdy, rdz, &k[0], st, 1, 1);
-                    else if (is3d) u_line(u, v, w, H[0], us[0], c0, len, sx, sy, rdy, rdz, &k[0], st, 1, 0);
-                    else if (fused) u_line(u, v, w, H[0], us[0], c0, len, sx, sy, rdy, rdz, &k[0], st, 0, 1);
-                    else u_line(u, v, w, H[0], us[0], c0, len, sx, sy, rdy, rdz, &k[0], st, 0, 0);
-                } else if (c == 1) {
-                    if (is3d && fused) v_line(u, v, w, H[1], us[1], c0, len, sx, sy, rdy, rdz, &k[1], st, 1, 1);
-                    else if (is3d) v_line(u, v, w, H[1], us[1], c0, len, sx, sy, rdy, rdz, &k[1], st, 1, 0);
-                    else if (fused) v_line(u, v, w, H[1], us[1], c0, len, sx, sy, rdy, rdz, &k[1], st, 0, 1);
-                    else v_line(u, v, w, H[1], us[1], c0, len, sx, sy, rdy, rdz, &k[1], st, 0, 0);
-                } else {
-                    if (fused) w_line(u, v, w, H[2], us[2], c0, len, sx, sy, rdy, rdz, &k[2], st, 1);
-                    else w_line(u, v, w, H[2], us[2], c0, len, sx, sy, rdy, rdz, &k[2], st, 0);
-                }
+                double *Hc = H ? H[c] : NULL;
+                if (c == 0) LINE_VARIANTS(u_line, (u, v, w, Hc, us[0], c0, len, sx, sy, rdy, rdz, &k[0], st, is3d_,
+                                                   fused_, hold_, hstore_));
+                else if (c == 1) LINE_VARIANTS(v_line, (u, v, w, Hc, us[1], c0, len, sx, sy, rdy, rdz, &k[1], st,
+                                                        is3d_, fused_, hold_, hstore_));
+                else if (is3d) LINE_VARIANTS_3D(w_line, (u, v, w, Hc, us[2], c0, len, sx, sy, rdy, rdz, &k[2], st,
+                                                         fused_, hold_, hstore_));
             }
     }
 }

@@ -55,7 +55,8 @@ static inline double dmax(double a, double b) { return a > b ? a : b; }
 /* advection.c: out = ca·∇·(u⊗u) + cv·L u, one fused sweep */
 void fluid_rhs(const fluid_t *f, double ca, double cv, double *const out[3]);
 /* the same, H = ca·N + cv·L u, with the predictor in the same sweep:
- * US[c] (H_old on entry) ← u + dg·H + dz·H_old + adt·(f − G p) + ce·L u */
+ * US[c] (H_old on entry) ← u + dg·H + dz·H_old + adt·(f − G p) + ce·L u;
+ * H_old is not read when dz = 0, H not stored when H is NULL */
 void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
                        double *const H[3], double *const US[3]);
 /* viscous.c */

@@ -10,7 +10,8 @@
  *            problem (L − λ) u* = −λ rhs − (wall terms), λ = 2/(α_k Δt ν)]
  *   stage hook (immersed boundary) on u*
  *   L φ   = D u* / (α_k Δt),   u^k = u* − α_k Δt G φ,
- *   p^k   = p^{k−1} + φ  [− α_k Δt ν/2 L φ when Crank–Nicolson].
+ *   p^k   = p^{k−1} + φ  [− α_k Δt ν/2 L φ when Crank–Nicolson],
+ *   stage-end hook (immersed boundary: particle update) on u^k.
  * Since L = D·G (poisson.c), D u^k = 0 to the solver's round-off.
  */
 #include <math.h>
@@ -18,8 +19,8 @@
 #include "fluid_internal.h"
 #include "util.h"
 
-static const double rk_gamma[3] = {8.0 / 15.0, 5.0 / 12.0, 3.0 / 4.0};
-static const double rk_zeta[3] = {0.0, -17.0 / 60.0, -5.0 / 12.0};
+const double fluid_rk_gamma[3] = {8.0 / 15.0, 5.0 / 12.0, 3.0 / 4.0};
+const double fluid_rk_zeta[3] = {0.0, -17.0 / 60.0, -5.0 / 12.0};
 
 /* Stride and inverse spacing of the gradient of a cell-centred field at the
  * unknowns of component c (x: per i). */
@@ -27,6 +28,59 @@ static inline long grad_stride(const grid_t *g, int c) { return c == 0 ? g->sx :
 static inline double grad_rdx(const grid_t *g, int c, int i)
 {
     return c == 0 ? 1.0 / g->dxc[i] : c == 1 ? 1.0 / g->dy : 1.0 / g->dz;
+}
+
+/* u^k = u* − α Δt G φ on the unknowns of every component.  The sweep runs
+ * plane by plane and line by line with the components inside (as the
+ * right-hand side sweep of advection.c), so that each line of φ is read from
+ * memory once for the three components.  With `stats`, also accumulate
+ * Σ V u² (stats[0]) and max |u| (stats[1]) of the projected field for the
+ * diagnostics.  With `fuse_p` the pressure update p += φ (explicit viscous
+ * terms) is done on the lines of u, whose unknowns are the pressure cells
+ * except the plane beyond an x wall (left to the caller). */
+static void correct_velocity(fluid_t *f, const double *restrict ph, double dt_stage, int fuse_p, double *stats)
+{
+    const grid_t *g = f->g;
+    int nc = fluid_ncomp(g), is3d = g->dim == 3;
+    int iend[3], nj[3], nk[3];
+    long sp[3];
+    double e[3] = {0.0, 0.0, 0.0}, um = stats ? stats[1] : 0.0;
+    for (int c = 0; c < nc; c++) {
+        iend[c] = fluid_iend(g, c);
+        nj[c] = fluid_nu(g, c, 1);
+        nk[c] = fluid_nu(g, c, 2);
+        sp[c] = grad_stride(g, c);
+    }
+    double *restrict p = f->p;
+    for (int i = 0; i < g->nxl; i++) {
+        double a[3], ei[3] = {0.0, 0.0, 0.0};
+        for (int c = 0; c < nc; c++) a[c] = dt_stage * grad_rdx(g, c, i);
+        int nl = is3d ? g->n[1] : 1;
+        for (int jl = 0; jl < nl; jl++)
+            for (int c = 0; c < nc; c++) {
+                if (i >= iend[c] || (is3d && jl >= nj[c])) continue;
+                double *restrict u = f->u[c];
+                long c0 = G_IDX(g, i, jl, 0), len = is3d ? nk[c] : nj[c], s = sp[c];
+                double ac = a[c];
+                if (!stats)
+                    for (long m = c0; m < c0 + len; m++) u[m] -= ac * (ph[m + s] - ph[m]);
+                else
+                    for (long m = c0; m < c0 + len; m++) {
+                        double x = u[m] - ac * (ph[m + s] - ph[m]);
+                        u[m] = x;
+                        ei[c] += x * x;
+                        um = dmax(um, fabs(x));
+                    }
+                if (c == 0 && fuse_p)
+                    for (long m = c0; m < c0 + len; m++) p[m] += ph[m];
+            }
+        if (stats)
+            for (int c = 0; c < nc; c++) e[c] += fluid_cell_volume(f, c, i) * ei[c];
+    }
+    if (stats) {
+        stats[0] += e[0] + e[1] + e[2];
+        stats[1] = um;
+    }
 }
 
 void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats)
@@ -41,32 +95,9 @@ void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, doubl
     f->diag.res_poisson = q->pp->last_residual;
     f->diag.it_poisson = q->pp->last_iterations;
     fluid_fill_pressure_ghosts(f, phi);
-    /* u −= α Δt G φ; with `stats`, also accumulate Σ V u² (stats[0]) and
-     * max |u| (stats[1]) of the projected field for the diagnostics */
-    for (int c = 0; c < fluid_ncomp(g); c++) {
-        double *restrict u = f->u[c];
-        const double *restrict ph = phi;
-        long sp = grad_stride(g, c);
-        int iend = fluid_iend(g, c), nj = fluid_nu(g, c, 1), nk = fluid_nu(g, c, 2);
-        for (int i = 0; i < iend; i++) {
-            double a = dt_stage * grad_rdx(g, c, i);
-            if (!stats) {
-                FLUID_FOR_LINES(g, i, nj, nk, c0, len)
-                for (long m = c0; m < c0 + len; m++) u[m] -= a * (ph[m + sp] - ph[m]);
-                continue;
-            }
-            double e = 0.0, um = stats[1];
-            FLUID_FOR_LINES(g, i, nj, nk, c0, len)
-            for (long m = c0; m < c0 + len; m++) {
-                double x = u[m] - a * (ph[m + sp] - ph[m]);
-                u[m] = x;
-                e += x * x;
-                um = dmax(um, fabs(x));
-            }
-            stats[0] += fluid_cell_volume(f, c, i) * e;
-            stats[1] = um;
-        }
-    }
+    /* u −= α Δt G φ [and p += φ with explicit viscous terms], one sweep */
+    int fuse_p = update_pressure && !f->prm.implicit_viscous;
+    correct_velocity(f, phi, dt_stage, fuse_p, stats);
     if (update_pressure) {
         if (f->prm.implicit_viscous) {
             /* p += φ − (α Δt ν/2) L φ: the pressure consistent with the
@@ -92,7 +123,8 @@ void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, doubl
                 }
             }
         } else {
-            for (int i = 0; i < g->nxl; i++)
+            /* p += φ on the planes the sweep of u above did not cover */
+            for (int i = fluid_iend(g, 0); i < g->nxl; i++)
                 FLUID_FOR_LINES(g, i, g->n[1], g->n[2], c0, len)
                 for (long m = c0; m < c0 + len; m++) f->p[m] += phi[m];
         }
@@ -100,6 +132,8 @@ void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, doubl
     }
     fluid_apply_bc(f);
 }
+
+void fluid_stage_project(fluid_t *f, double dt_stage) { fluid_project_stage(f, dt_stage, 1, NULL); }
 
 void fluid_project(fluid_t *f)
 {
@@ -131,15 +165,17 @@ void fluid_step(fluid_t *f, double dt)
     int nc = fluid_ncomp(g);
     double stats[2] = {0.0, 0.0};
     for (int s = 0; s < 3; s++) {
-        double adt = (rk_gamma[s] + rk_zeta[s]) * dt;
+        double adt = (fluid_rk_gamma[s] + fluid_rk_zeta[s]) * dt;
         /* H^k = −∇·(u⊗u) [+ νLu] from u^{k−1} (its ghosts are valid: every
          * stage ends with them) into spare, and the predictor
          * u* = u^{k−1} + Δt(γH^k + ζH^{k−1}) + αΔt(f − G p) [+ αΔtν/2 L u^{k−1}]
          * over h (which held H^{k−1}), in one sweep; then rotate:
-         * u ← u*, h ← H^k, spare ← u^{k−1} (free). */
+         * u ← u*, h ← H^k, spare ← u^{k−1} (free).  The last stage's H is
+         * not needed (ζ_1 = 0: the first stage of the next step does not
+         * read H_old), so it is not stored. */
         int impl = f->prm.implicit_viscous;
-        fluid_rhs_predict(f, -1.0, impl ? 0.0 : f->prm.nu, dt * rk_gamma[s], dt * rk_zeta[s], adt,
-                          impl ? 0.5 * adt * f->prm.nu : 0.0, q->spare, q->h);
+        fluid_rhs_predict(f, -1.0, impl ? 0.0 : f->prm.nu, dt * fluid_rk_gamma[s], dt * fluid_rk_zeta[s], adt,
+                          impl ? 0.5 * adt * f->prm.nu : 0.0, s < 2 ? q->spare : NULL, q->h);
         for (int c = 0; c < nc; c++) {
             double *old = f->u[c];
             f->u[c] = q->h[c];
@@ -154,6 +190,7 @@ void fluid_step(fluid_t *f, double dt)
             fluid_apply_bc(f);
         }
         fluid_project_stage(f, adt, 1, s == 2 ? stats : NULL);
+        if (f->stage_end_hook) f->stage_end_hook(f, s, adt, f->hook_ctx);
     }
     f->time += dt;
     f->step++;

@@ -159,6 +159,14 @@ void io_h5_write_array(hid_t loc, const char *name, long n, const double *v)
     H5Sclose(fs);
 }
 
+void io_h5_write_matrix(hid_t loc, const char *name, long n, int m, const double *v)
+{
+    hsize_t dim[2] = {(hsize_t)n, (hsize_t)m};
+    hid_t fs = H5Screate_simple(2, dim, NULL);
+    write_rank0(loc, name, H5T_NATIVE_DOUBLE, fs, v);
+    H5Sclose(fs);
+}
+
 long io_h5_read_array(hid_t loc, const char *name, long nmax, double *v)
 {
     if (H5Lexists(loc, name, H5P_DEFAULT) <= 0) return -1;

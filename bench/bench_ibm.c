@@ -1,0 +1,122 @@
+/* bench_ibm.c — cost of the immersed boundary (solid fraction, forcing,
+ * integrals and sphere update, at all three RK3 stages) for many spheres,
+ * as a fraction of the cost of the fluid step it is part of.
+ *
+ * Scene: a triply periodic box of N³ cells, Δx = D/dpd, with `count` free
+ * spheres (ρ_p/ρ = 2, under gravity) placed at random without overlap
+ * (random sequential addition, fixed seed).  The fluid alone is timed over
+ * `steps` steps, then the same steps with the spheres: the immersed
+ * boundary's own timers (ibm->wall_*) give its cost, and the difference of
+ * the two step times checks them.
+ *
+ * usage: bench_ibm [N=128] [count=1000] [dpd=10] [steps=3] [explicit|implicit]
+ * prints: fluid step, immersed-boundary time per step (α, forcing,
+ * integrals), its fraction of the fluid step, node entries per sphere.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fluid.h"
+#include "ibm.h"
+#include "util.h"
+
+static double urand(unsigned long *s)
+{
+    *s = *s * 6364136223846793005UL + 1442695040888963407UL;
+    return (double)(*s >> 11) / 9007199254740992.0;
+}
+
+static double time_steps(fluid_t *f, int steps, double dt)
+{
+    MPI_Barrier(MPI_COMM_WORLD);
+    double t0 = wtime();
+    for (int s = 0; s < steps; s++) fluid_step(f, dt);
+    double t = (wtime() - t0) / steps;
+    MPI_Allreduce(MPI_IN_PLACE, &t, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    return t;
+}
+
+int main(int argc, char **argv)
+{
+    MPI_Init(&argc, &argv);
+    int N = argc > 1 ? atoi(argv[1]) : 128;
+    int count = argc > 2 ? atoi(argv[2]) : 1000;
+    double dpd = argc > 3 ? atof(argv[3]) : 10;
+    int steps = argc > 4 ? atoi(argv[4]) : 3;
+    int implicit = argc > 5 && !strcmp(argv[5], "implicit");
+
+    double dx = 1.0 / dpd, L = N * dx;
+    int n[3] = {N, N, N};
+    double Lv[3] = {L, L, L};
+    grid_t *g = grid_create(GEOM_3D, n, Lv, NULL, NULL, STRETCH_UNIFORM, 0, MPI_COMM_WORLD);
+    fluid_params_t prm;
+    memset(&prm, 0, sizeof prm);
+    prm.nu = 0.01;
+    prm.rho = 1;
+    prm.implicit_viscous = implicit;
+    prm.poisson.method = POISSON_FFT;
+    fluid_t *f = fluid_create(g, &prm);
+
+    /* random sequential addition, identical on every rank */
+    ibm_sphere_t *s = xcalloc((size_t)count, sizeof *s);
+    unsigned long seed = 12345;
+    int placed = 0;
+    for (long tries = 0; placed < count && tries < 1000000L * count; tries++) {
+        double x[3];
+        for (int d = 0; d < 3; d++) x[d] = L * urand(&seed);
+        int ok = 1;
+        for (int q = 0; q < placed && ok; q++) {
+            double r2 = 0;
+            for (int d = 0; d < 3; d++) {
+                double dd = x[d] - s[q].x[d];
+                dd -= L * round(dd / L);
+                r2 += dd * dd;
+            }
+            ok = r2 >= 1.0;
+        }
+        if (!ok) continue;
+        s[placed].kind = IBM_FREE;
+        s[placed].radius = 0.5;
+        s[placed].density = 2.0;
+        memcpy(s[placed].x, x, sizeof x);
+        s[placed].history = -1;
+        placed++;
+    }
+    if (placed < count) die("could place only %d of %d spheres", placed, count);
+    double phi = count * M_PI / 6 / (L * L * L);
+
+    double dt = 0.2 * dx; /* a CFL of 0.2 at unit velocity */
+    if (!implicit) dt = fmin(dt, 0.5 * dx * dx / (6 * prm.nu));
+    fluid_step(f, dt); /* warm-up: FFTW plans, first touches */
+    double t_fluid = time_steps(f, steps, dt);
+
+    ibm_params_t ip = ibm_default_params();
+    ip.gravity[1] = -1.0;
+    ibm_t *ibm = ibm_create(f, &ip, s, count);
+    fluid_step(f, dt);
+    double w0 = ibm->wall_alpha + ibm->wall_forcing + ibm->wall_integrals;
+    double a0 = ibm->wall_alpha, f0 = ibm->wall_forcing, i0 = ibm->wall_integrals;
+    double t_both = time_steps(f, steps, dt);
+    double w[4] = {(ibm->wall_alpha - a0) / steps, (ibm->wall_forcing - f0) / steps,
+                   (ibm->wall_integrals - i0) / steps, 0};
+    w[3] = (ibm->wall_alpha + ibm->wall_forcing + ibm->wall_integrals - w0) / steps;
+    MPI_Allreduce(MPI_IN_PLACE, w, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    double nodes = grid_sum(g, (double)ibm->nodes_forced), shared = grid_sum(g, (double)ibm->nodes_shared);
+    msg("bench_ibm: %d^3 cells, %d ranks, %s viscous term; %d spheres at D/dx = %g (solid fraction %.3f)\n", N,
+        g->nranks, implicit ? "Crank-Nicolson" : "explicit", count, dpd, phi);
+    msg("  fluid step alone            %8.4f s\n", t_fluid);
+    msg("  fluid step with the spheres %8.4f s (difference %.4f s)\n", t_both, t_both - t_fluid);
+    msg("  immersed boundary per step  %8.4f s: alpha %.4f, forcing %.4f, integrals + update %.4f\n", w[3], w[0], w[1],
+        w[2]);
+    msg("  fraction of the fluid step  %8.1f %%  (target <= 25 %%)\n", 100 * w[3] / t_fluid);
+    msg("  node entries per sphere     %8.0f (%.1f MB on all ranks), %.1f %% in runs shared with a neighbour\n",
+        nodes / count, nodes * (8 + 40.0 / 8) / 1e6, 100 * shared / nodes);
+    ibm_free(ibm);
+    free(s);
+    fluid_free(f);
+    grid_free(g);
+    MPI_Finalize();
+    return 0;
+}

@@ -1,0 +1,402 @@
+/* forcing.c — the direct forcing of every RK3 stage, the hydrodynamic force
+ * and torque of each sphere, and the rigid-body update of the spheres.
+ *
+ * Stage k (Δt_k = (γ_k + ζ_k) Δt), fluid hooks of fluid.h:
+ *
+ *  before the projection (ibm_stage_force), on the predicted velocity u*:
+ *     u* ← u* + α (U − u*)         at every node with α > 0,
+ *  U the rigid-body velocity u_p + ω_p × r of the sphere at the start of the
+ *  stage, i.e. f = α (U − u*)/Δt_k.  Overlapping spheres: α = min(1, Σ α_p)
+ *  and U the α-weighted mean of their velocities; sphere p takes the share
+ *  α_p/Σα_p of the node's impulse.  With forcing_iterations = N the pair
+ *  (force, project) is done N extra times before the final forcing.
+ *
+ *  after the projection (ibm_stage_end), on u^k: each sphere's solid
+ *  fraction is moved to the explicit prediction X^k = x^{k−1} + Δt_k u^{k−1}
+ *  (prescribed: the prescribed motion), and
+ *     I^k = ∫ α(X^k) u^k dV,   L^k = ∫ α(X^k) (x − X^k) × u^k dV,
+ *     J = ρ (I^k − I^{k−1}) − ρ ∫ f dV Δt_k,
+ *     K = ρ (L^k − L^{k−1} + Δt_k u × I) − ρ ∫ r × f dV Δt_k
+ *  are the hydrodynamic impulses (force and torque × Δt_k) of the pressure
+ *  relative to hydrostatic and the viscous stress: the momentum balance of
+ *  the fluid inside the moving sphere volume (Uhlmann 2005; Kempe & Fröhlich
+ *  2012; Breugem 2012) — the flux of momentum through the surface cancels
+ *  because the fluid there moves with it; u × I comes from the moving
+ *  reference point of L.  Taking I and L with the α of the moving sphere
+ *  matters: at a steady translation through the grid the α-weighted
+ *  momentum is then constant and the drag is exactly −ρ ∫ f dV; with a
+ *  fixed α the band's fluid, which lags the sphere, would bias it.  A free
+ *  sphere then moves by
+ *     (m_p + C_v ρ V_p) Δu = J + (ρ_p − ρ) V_p g Δt_k + C_v ρ V_p Δu_prev,
+ *     (I_p + C_v (ρ/ρ_p) I_p) Δω = K + C_v (ρ/ρ_p) I_p Δω_prev,
+ *     x^k = x^{k−1} + Δt_k (u^{k−1} + Δu/2)     (X^k − x^k = O(Δt_k² du/dt)),
+ *  where the C_v terms stabilise light spheres (virtual mass, Schwarz,
+ *  Kempe & Fröhlich 2015) without changing any steady state.  Why: the
+ *  explicit coupling measures the fluid's reaction to the velocity jumps
+ *  of the previous stages — the projection keeps about 2/3 of a jump
+ *  imposed inside a sphere and returns 1/3 as a pressure impulse, measured
+ *  at the next stage, and so on (a geometric series of ratio 1/3 whose sum
+ *  is the added mass ½ρV).  With that response the stage-to-stage
+ *  amplification z of the plain coupling is (1 − ρ/ρ_p)/3: unstable below
+ *  ρ_p/ρ = 1/4 (measured: 0.3 runs, 0.2 diverges).  With C_v = c and
+ *  r = ρ_p/ρ, 3(r + c)z² + (1 − r − 4c)z + c = 0: c = 0.1 keeps |z| ≤ 0.33
+ *  for r ≥ 0.2 and |z| < 1 down to r ≈ 0.05 (docs/theory.md §6b).
+ *  The seed's rigid-body model (force_model = rigid, eq. 2.32) instead
+ *  assumes the fluid inside moves rigidly:
+ *     Δu = g Δt_k − ρ ∫ f dV Δt_k / ((ρ_p − ρ) V_p).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "ibm_internal.h"
+#include "util.h"
+
+/* r × (a e_c) for a vector a e_c along axis c */
+static inline void cross_axis(const double r[3], int c, double a, double out[3])
+{
+    switch (c) {
+    case 0: out[0] = 0.0, out[1] = r[2] * a, out[2] = -r[1] * a; break;
+    case 1: out[0] = -r[2] * a, out[1] = 0.0, out[2] = r[0] * a; break;
+    default: out[0] = r[1] * a, out[1] = -r[0] * a, out[2] = 0.0; break;
+    }
+}
+
+/* β of a node of solid fraction a (see ibm.h): the seed's β = α, or the
+ * implicit relaxation over the stage with the time scale τ = κ h²/ν. */
+static inline double forcing_beta(double a, double dt, double tau)
+{
+    if (tau <= 0.0 || a >= 1.0) return a;
+    return a * dt / ((1.0 - a) * tau + a * dt);
+}
+
+/* One forcing of the current velocity; adds the impulse ∫ f dV Δt_k of each
+ * sphere and its moment to sum[IBM_FIMP..].  A run that no other sphere's
+ * band reaches (run->shared = 0, alpha.c) is forced directly; the shared
+ * runs go through the dense scratch, where a node takes α = min(1, Σα_p),
+ * the α-weighted mean velocity, and each sphere the share α_p/Σα of its
+ * impulse. */
+static void force_pass(ibm_t *ibm, double dt)
+{
+    const grid_t *g = ibm->g;
+    ibm_priv_t *q = ibm_priv(ibm);
+    fluid_t *f = ibm->f;
+    double kappa = ibm->prm.forcing_time, nu = f->prm.nu, step = q->rstep;
+    long st = q->rstride;
+    int rd = q->rdir, shared = 0;
+    for (int p = 0; p < ibm->n; p++) {
+        const ibm_sphere_t *s = &ibm->s[p];
+        double *sum = q->sum + (long)p * IBM_NSUM, J[3] = {0, 0, 0}, T[3] = {0, 0, 0};
+        for (long ir = q->start[p]; ir < q->start[p + 1]; ir++) {
+            const ibm_run_t *run = &q->runs[ir];
+            int c = run->c;
+            if (run->shared) {
+                /* Σ α_p and Σ α_p U_p for the shared pass below */
+                double *A = q->asum[c] + run->m0, *B = q->aux[c] + run->m0, r[3] = {run->r0[0], run->r0[1], run->r0[2]};
+                for (int k = 0; k < run->len; k++, r[rd] += step) {
+                    double a = q->alpha[run->a0 + k];
+                    A[k * st] += a;
+                    B[k * st] += a * ibm_rigid_velocity(s, c, r);
+                }
+                shared = 1;
+                continue;
+            }
+            int i = ibm_node_i(g, run->m0);
+            double *u = f->u[c] + run->m0;
+            const double *al = q->alpha + run->a0;
+            double h = q->hcell[c][i], tau = kappa > 0 ? kappa * h * h / nu : 0.0, vol = q->vol[c][i];
+            double r[3] = {run->r0[0], run->r0[1], run->r0[2]}, jr = 0, t[3];
+            for (int k = 0; k < run->len; k++, r[rd] += step) {
+                double imp = forcing_beta(al[k], dt, tau) * (ibm_rigid_velocity(s, c, r) - u[k * st]);
+                u[k * st] += imp;
+                jr += imp;
+                cross_axis(r, c, imp, t);
+                for (int d = 0; d < 3; d++) T[d] += t[d] * vol;
+            }
+            J[c] += jr * vol;
+        }
+        for (int d = 0; d < 3; d++) {
+            sum[IBM_FIMP + d] += J[d];
+            sum[IBM_TIMP + d] += T[d];
+        }
+    }
+    if (!shared) return;
+    /* force each shared node once (u ← u + β (U − u)); keep the impulse in
+     * aux and mark the node done by the sign of asum */
+    for (long ir = 0; ir < q->nruns; ir++) {
+        const ibm_run_t *run = &q->runs[ir];
+        if (!run->shared) continue;
+        int c = run->c, i = ibm_node_i(g, run->m0);
+        double h = q->hcell[c][i], tau = kappa > 0 ? kappa * h * h / nu : 0.0;
+        double *A = q->asum[c] + run->m0, *B = q->aux[c] + run->m0, *u = f->u[c] + run->m0;
+        for (int k = 0; k < run->len; k++) {
+            double Ak = A[k * st];
+            if (Ak <= 0.0) continue;
+            double imp = forcing_beta(Ak < 1.0 ? Ak : 1.0, dt, tau) * (B[k * st] / Ak - u[k * st]);
+            u[k * st] += imp;
+            B[k * st] = imp;
+            A[k * st] = -Ak;
+        }
+    }
+    /* each sphere's share α_p/Σα of the impulse, and its moment */
+    for (int p = 0; p < ibm->n; p++) {
+        double *sum = q->sum + (long)p * IBM_NSUM, t[3];
+        for (long ir = q->start[p]; ir < q->start[p + 1]; ir++) {
+            const ibm_run_t *run = &q->runs[ir];
+            if (!run->shared) continue;
+            int c = run->c;
+            double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]};
+            const double *A = q->asum[c] + run->m0, *B = q->aux[c] + run->m0;
+            for (int k = 0; k < run->len; k++, r[rd] += step) {
+                if (A[k * st] >= 0.0) continue; /* α = 0 at the end of a run: not forced */
+                double J = q->alpha[run->a0 + k] / -A[k * st] * B[k * st] * vol;
+                sum[IBM_FIMP + c] += J;
+                cross_axis(r, c, J, t);
+                for (int d = 0; d < 3; d++) sum[IBM_TIMP + d] += t[d];
+            }
+        }
+    }
+    for (long ir = 0; ir < q->nruns; ir++) {
+        const ibm_run_t *run = &q->runs[ir];
+        if (!run->shared) continue;
+        for (int k = 0; k < run->len; k++) {
+            q->asum[run->c][run->m0 + k * st] = 0.0;
+            q->aux[run->c][run->m0 + k * st] = 0.0;
+        }
+    }
+}
+
+/* ∫ α_p u dV and ∫ α_p r × u dV of every sphere on this rank into
+ * sum[IBM_MOM..IBM_ANG+2]. */
+void ibm_momentum(ibm_t *ibm, double *sum_all)
+{
+    const grid_t *g = ibm->g;
+    ibm_priv_t *q = ibm_priv(ibm);
+    long st = q->rstride;
+    int rd = q->rdir;
+    for (int p = 0; p < ibm->n; p++) {
+        double *sum = sum_all + (long)p * IBM_NSUM, I[3] = {0, 0, 0}, Lm[3] = {0, 0, 0}, t[3];
+        for (long ir = q->start[p]; ir < q->start[p + 1]; ir++) {
+            const ibm_run_t *run = &q->runs[ir];
+            int c = run->c;
+            const double *u = ibm->f->u[c] + run->m0, *al = q->alpha + run->a0;
+            double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]}, s = 0;
+            for (int k = 0; k < run->len; k++, r[rd] += q->rstep) {
+                double a = al[k] * u[k * st];
+                s += a;
+                cross_axis(r, c, a * vol, t);
+                for (int d = 0; d < 3; d++) Lm[d] += t[d];
+            }
+            I[c] += s * vol;
+        }
+        for (int d = 0; d < 3; d++) {
+            sum[IBM_MOM + d] = I[d];
+            sum[IBM_ANG + d] = Lm[d];
+        }
+    }
+}
+
+static void reduce_sums(ibm_t *ibm)
+{
+    ibm_priv_t *q = ibm_priv(ibm);
+    if (ibm->g->nranks > 1)
+        MPI_Allreduce(MPI_IN_PLACE, q->sum, ibm->n * IBM_NSUM, MPI_DOUBLE, MPI_SUM, ibm->g->comm);
+}
+
+/* Node lists at the current xa, then I and L into mom_prev. */
+void ibm_rebuild_geometry(ibm_t *ibm)
+{
+    double w0 = wtime();
+    ibm_priv_t *q = ibm_priv(ibm);
+    ibm_build_nodes(ibm);
+    double w1 = wtime();
+    memset(q->sum, 0, (size_t)ibm->n * IBM_NSUM * sizeof(double));
+    ibm_momentum(ibm, q->sum);
+    reduce_sums(ibm);
+    for (int p = 0; p < ibm->n; p++)
+        for (int d = 0; d < 6; d++) q->mom_prev[6 * p + d] = q->sum[(long)p * IBM_NSUM + IBM_MOM + d];
+    ibm->wall_alpha += w1 - w0;
+    ibm->wall_integrals += wtime() - w1;
+}
+
+void ibm_update_geometry(ibm_t *ibm)
+{
+    for (int p = 0; p < ibm->n; p++) memcpy(ibm->s[p].xa, ibm->s[p].x, sizeof ibm->s[p].x);
+    ibm_rebuild_geometry(ibm);
+}
+
+void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
+{
+    ibm_t *ibm = ctx;
+    ibm_priv_t *q = ibm_priv(ibm);
+    double w0 = wtime();
+    if (stage == 0) {
+        q->t_step = 0.0;
+        q->t_stage0 = f->time;
+        memset(q->imp_step, 0, (size_t)ibm->n * 6 * sizeof(double));
+    }
+    memset(q->sum, 0, (size_t)ibm->n * IBM_NSUM * sizeof(double));
+    for (int it = 0; it < ibm->prm.forcing_iterations; it++) {
+        force_pass(ibm, dt_stage);
+        fluid_stage_project(f, dt_stage);
+    }
+    force_pass(ibm, dt_stage);
+    ibm->wall_forcing += wtime() - w0;
+}
+
+/* Mask the components a geometry does not have: axisymmetric spheres move
+ * along the axis (y) only and do not rotate; discs move in the plane and
+ * rotate about z. */
+static void mask_geometry(const grid_t *g, double v[3], double w[3])
+{
+    if (g->geom == GEOM_AXI) {
+        v[0] = v[2] = 0.0;
+        w[0] = w[1] = w[2] = 0.0;
+    } else if (g->dim == 2) {
+        v[2] = 0.0;
+        w[0] = w[1] = 0.0;
+    }
+}
+
+/* Where the solid fraction of sphere s goes at the end of a stage of
+ * length dt ending at t_end: the explicit prediction. */
+static void predict_centre(const ibm_t *ibm, ibm_sphere_t *s, double dt, double t_end)
+{
+    double u1[3], w1[3];
+    switch (s->kind) {
+    case IBM_FIXED: memcpy(s->xa, s->x, sizeof s->xa); return;
+    case IBM_PRESCRIBED:
+        ibm_prescribed_velocity(ibm, s, t_end, u1, w1);
+        mask_geometry(ibm->g, u1, w1);
+        for (int c = 0; c < 3; c++) s->xa[c] = s->x[c] + 0.5 * dt * (s->u[c] + u1[c]);
+        return;
+    default:
+        for (int c = 0; c < 3; c++) s->xa[c] = s->x[c] + dt * s->u[c];
+    }
+}
+
+/* Put a coordinate back in the domain along the periodic directions. */
+static void wrap_periodic(const grid_t *g, double x[3])
+{
+    for (int d = 0; d < g->dim; d++)
+        if (g->periodic[d]) {
+            double L = g->L[d];
+            while (x[d] < g->x0[d]) x[d] += L;
+            while (x[d] >= g->x0[d] + L) x[d] -= L;
+        }
+}
+
+/* Advance sphere p over the stage from the reduced sums (I^k, L^k about
+ * X^k = xa, and the forcing impulses); J, K: its hydrodynamic impulses. */
+static void update_sphere(ibm_t *ibm, int p, double dt, double t_end, double J[3], double K[3])
+{
+    const grid_t *g = ibm->g;
+    ibm_priv_t *q = ibm_priv(ibm);
+    ibm_sphere_t *s = &ibm->s[p];
+    const double *sum = q->sum + (long)p * IBM_NSUM, *prev = q->mom_prev + 6 * p;
+    double rho = ibm->f->prm.rho, V = ibm_volume(ibm, p), m = ibm_mass(ibm, p), I = ibm_inertia(ibm, p);
+    /* u × I with I the mean over the stage (≈ V u × u = 0 for a rigid interior) */
+    double Im[3];
+    for (int c = 0; c < 3; c++) Im[c] = 0.5 * (sum[IBM_MOM + c] + prev[c]);
+    double uxI[3] = {s->u[1] * Im[2] - s->u[2] * Im[1], s->u[2] * Im[0] - s->u[0] * Im[2],
+                     s->u[0] * Im[1] - s->u[1] * Im[0]};
+    int rigid = ibm->prm.force_model == IBM_FORCE_RIGID;
+    double u0[3], w0[3], du[3] = {0, 0, 0}, dw[3] = {0, 0, 0};
+    memcpy(u0, s->u, sizeof u0);
+    memcpy(w0, s->omega, sizeof w0);
+    for (int c = 0; c < 3; c++) {
+        J[c] = rho * (sum[IBM_MOM + c] - prev[c] - sum[IBM_FIMP + c]);
+        K[c] = rho * (sum[IBM_ANG + c] - prev[3 + c] + dt * uxI[c] - sum[IBM_TIMP + c]);
+    }
+    switch (s->kind) {
+    case IBM_FREE: {
+        double rp = s->density;
+        if (!rigid) {
+            double mv = ibm->prm.virtual_mass * rho * V, Iv = ibm->prm.virtual_mass * rho / rp * I;
+            for (int c = 0; c < 3; c++) {
+                double W = (rp - rho) * V * ibm->prm.gravity[c];
+                du[c] = (J[c] + W * dt + mv * s->du_prev[c]) / (m + mv);
+                dw[c] = (K[c] + Iv * s->dw_prev[c]) / (I + Iv);
+            }
+        } else {
+            /* eq. 2.32–2.33 with the pressure relative to hydrostatic */
+            for (int c = 0; c < 3; c++) {
+                du[c] = ibm->prm.gravity[c] * dt - rho * sum[IBM_FIMP + c] / ((rp - rho) * V);
+                dw[c] = -rho * rp / (rp - rho) * sum[IBM_TIMP + c] / I;
+            }
+        }
+        mask_geometry(g, du, dw);
+        for (int c = 0; c < 3; c++) {
+            s->x[c] += dt * (s->u[c] + 0.5 * du[c]);
+            s->u[c] += du[c];
+            s->omega[c] += dw[c];
+            s->du_prev[c] = du[c];
+            s->dw_prev[c] = dw[c];
+        }
+        break;
+    }
+    case IBM_FIXED: break;
+    case IBM_PRESCRIBED:
+        ibm_prescribed_velocity(ibm, s, t_end, s->u, s->omega);
+        mask_geometry(g, s->u, s->omega);
+        memcpy(s->x, s->xa, sizeof s->x);
+        for (int c = 0; c < 3; c++) {
+            du[c] = s->u[c] - u0[c];
+            dw[c] = s->omega[c] - w0[c];
+        }
+        break;
+    case IBM_EXTERNAL: memcpy(s->x, s->xa, sizeof s->x); break;
+    }
+    if (rigid) {
+        /* the rigid interior of eq. 2.32: ρ V Δu − ρ ∫ f, ρ (I/ρ_p) Δω − ρ ∫ r × f */
+        double If = s->density > 0 ? I / s->density : 0.0;
+        for (int c = 0; c < 3; c++) {
+            J[c] = rho * (V * du[c] - sum[IBM_FIMP + c]);
+            K[c] = rho * (If * dw[c] - sum[IBM_TIMP + c]);
+        }
+    }
+    double none[3] = {0, 0, 0};
+    mask_geometry(g, J, none);
+    if (g->geom == GEOM_AXI) K[0] = K[1] = K[2] = 0.0;
+    if (g->dim == 2) K[0] = K[1] = 0.0;
+    wrap_periodic(g, s->x);
+}
+
+void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx)
+{
+    ibm_t *ibm = ctx;
+    ibm_priv_t *q = ibm_priv(ibm);
+    q->t_step += dt_stage;
+    double t_end = q->t_stage0 + q->t_step;
+    /* move the solid fraction to the predicted centres */
+    int moved = 0;
+    for (int p = 0; p < ibm->n; p++) {
+        ibm_sphere_t *s = &ibm->s[p];
+        double xa0[3];
+        memcpy(xa0, s->xa, sizeof xa0);
+        predict_centre(ibm, s, dt_stage, t_end);
+        wrap_periodic(ibm->g, s->xa);
+        moved |= memcmp(xa0, s->xa, sizeof xa0) != 0;
+    }
+    double w0 = wtime();
+    if (moved) ibm_build_nodes(ibm);
+    double w1 = wtime();
+    ibm_momentum(ibm, q->sum);
+    reduce_sums(ibm);
+    for (int p = 0; p < ibm->n; p++) {
+        double J[3], K[3];
+        update_sphere(ibm, p, dt_stage, t_end, J, K);
+        for (int d = 0; d < 3; d++) {
+            q->imp_step[6 * p + d] += J[d];
+            q->imp_step[6 * p + 3 + d] += K[d];
+        }
+        for (int d = 0; d < 6; d++) q->mom_prev[6 * p + d] = q->sum[(long)p * IBM_NSUM + IBM_MOM + d];
+    }
+    if (stage == 2)
+        for (int p = 0; p < ibm->n; p++)
+            for (int d = 0; d < 3; d++) {
+                ibm->s[p].force[d] = q->imp_step[6 * p + d] / q->t_step;
+                ibm->s[p].torque[d] = q->imp_step[6 * p + 3 + d] / q->t_step;
+            }
+    ibm->wall_alpha += w1 - w0;
+    ibm->wall_integrals += wtime() - w1;
+}

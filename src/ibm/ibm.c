@@ -1,0 +1,551 @@
+/* ibm.c — the [ibm] keys, the spheres of a case (keys sphere1..sphere9 and
+ * a file of many), creation, velocity histories, sphere properties. */
+#include <ctype.h>
+#include <hdf5.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "ibm_internal.h"
+#include "util.h"
+
+#define IBM_KEYED_SPHERES 9
+#define SPHERE_HELP                                                                                                \
+    "a sphere: KIND then tagged values in any order — KIND = free|fixed|prescribed; center X Y Z; radius R "     \
+    "(or diameter D); density RHO (free: required); velocity U V W; omega WX WY WZ; history FILE (prescribed: "  \
+    "CSV t,u,v,w[,ox,oy,oz], linear in t). Example: free center 0 10 0 diameter 1 density 4"
+#define SPHERE_KEY(N) {"ibm", "sphere" #N, CFG_STRING, NULL, 1, 0, NULL, N == 1 ? SPHERE_HELP : "as sphere1"}
+
+static const cfg_key_t ibm_keys[] = {
+    {"ibm", "force_model", CFG_ENUM, "momentum", 1, 0, "momentum|rigid",
+     "hydrodynamic force: forcing integral + rate of change of the fluid momentum inside the sphere "
+     "(momentum: any density ratio), or the seed's rigid-body formula -ρρp/(ρp-ρ)∫f dV (rigid: ρp/ρ well above 1)"},
+    {"ibm", "virtual_mass", CFG_DOUBLE, "0.1", 0, 10, NULL,
+     "momentum model: C_v of the stabilisation (m + C_v ρ V) Δu = ... + C_v ρ V Δu_previous (0: plain explicit "
+     "coupling, unstable below ρp/ρ = 0.25; 0.1: stable down to about 0.05, see docs/theory.md)"},
+    {"ibm", "forcing_iterations", CFG_INT, "0", 0, 20, NULL,
+     "extra (force, project) passes per Runge-Kutta stage before the final forcing (each costs a pressure solve)"},
+    {"ibm", "gravity", CFG_VEC3, "0 0 0", -1e300, 1e300, NULL,
+     "gravity acting on the free spheres (their immersed weight (ρp-ρ)V g; the fluid pressure is relative to "
+     "hydrostatic)"},
+    {"ibm", "forcing_time", CFG_DOUBLE, "0", 0, 1e6, NULL,
+     "κ: a node of solid fraction α < 1 is forced by u ← u + β(U − u), β = αΔt_k/((1−α)κh²/ν + αΔt_k), whose "
+     "steady state does not depend on the time step; 0: the seed's β = α at every stage (depends on Δt)"},
+    {"ibm", "retraction", CFG_DOUBLE, "0", -1, 1, NULL,
+     "the solid fraction is that of a sphere of radius R - retraction × Δx (cells): compensates the effective "
+     "thickening of the forced sphere (0: the seed's method)"},
+    {"ibm", "spheres_file", CFG_STRING, NULL, 1, 0, NULL,
+     "many spheres: a CSV file (header with x,y,z,radius or diameter; optional density,u,v,w,ox,oy,oz,kind or "
+     "fixed) or an HDF5 packing (.h5: datasets position [n][3], radius; optional density, velocity, omega, fixed)"},
+    {"ibm", "density", CFG_DOUBLE, NULL, 1e-300, 1e300, NULL,
+     "density of the spheres of spheres_file that give none (required if one is free and has none)"},
+    {"ibm", "series_spheres", CFG_INT, "4", 0, 4, NULL,
+     "the first this many spheres have their position, velocity, ω, force and torque as columns of series.csv"},
+    SPHERE_KEY(1), SPHERE_KEY(2), SPHERE_KEY(3), SPHERE_KEY(4), SPHERE_KEY(5), SPHERE_KEY(6), SPHERE_KEY(7),
+    SPHERE_KEY(8), SPHERE_KEY(9),
+    {NULL, NULL, 0, NULL, 0, 0, NULL, NULL}};
+
+void ibm_register_keys(void) { cfg_schema_add(ibm_keys); }
+
+ibm_params_t ibm_default_params(void)
+{
+    ibm_params_t p;
+    memset(&p, 0, sizeof p);
+    p.force_model = IBM_FORCE_MOMENTUM;
+    p.virtual_mass = 0.1;
+    return p;
+}
+
+/* ---- sphere properties --------------------------------------------------------- */
+
+double ibm_volume(const ibm_t *ibm, int p)
+{
+    double R = ibm->s[p].radius;
+    return ibm->g->dim == 3 || ibm->g->geom == GEOM_AXI ? 4.0 / 3.0 * M_PI * R * R * R : M_PI * R * R;
+}
+
+double ibm_mass(const ibm_t *ibm, int p) { return ibm->s[p].density * ibm_volume(ibm, p); }
+
+double ibm_inertia(const ibm_t *ibm, int p)
+{
+    double R = ibm->s[p].radius;
+    double k = ibm->g->dim == 3 || ibm->g->geom == GEOM_AXI ? 0.4 : 0.5;
+    return k * ibm_mass(ibm, p) * R * R;
+}
+
+double ibm_stable_dt(const ibm_t *ibm, double cfl)
+{
+    const grid_t *g = ibm->g;
+    double h = fmin(g->dy, g->dim == 3 ? g->dz : g->dy);
+    for (int i = 0; i < g->n[0]; i++) h = fmin(h, g->gdxf[i]);
+    double rate = 0.0;
+    for (int p = 0; p < ibm->n; p++) {
+        const ibm_sphere_t *s = &ibm->s[p];
+        double u = sqrt(s->u[0] * s->u[0] + s->u[1] * s->u[1] + s->u[2] * s->u[2]);
+        double w = sqrt(s->omega[0] * s->omega[0] + s->omega[1] * s->omega[1] + s->omega[2] * s->omega[2]);
+        rate = fmax(rate, (u + w * s->radius) / h);
+        if (s->kind == IBM_FREE) {
+            /* from rest, the sphere accelerates at most by |g|(1 − ρ/ρp): it
+             * moves one cell in √(2h/a) */
+            double gg = sqrt(ibm->prm.gravity[0] * ibm->prm.gravity[0] + ibm->prm.gravity[1] * ibm->prm.gravity[1] +
+                             ibm->prm.gravity[2] * ibm->prm.gravity[2]);
+            double a = gg * fabs(1.0 - ibm->f->prm.rho / s->density);
+            rate = fmax(rate, sqrt(a / h));
+        }
+    }
+    return rate > 0 ? cfl / rate : INFINITY;
+}
+
+/* ---- prescribed velocity histories ------------------------------------------------ */
+
+int ibm_add_history(ibm_t *ibm, int n, const double *rows)
+{
+    ibm_priv_t *q = ibm_priv(ibm);
+    if (n < 1) die("immersed boundary: an empty velocity history");
+    q->hist = realloc(q->hist, (size_t)(q->nhist + 1) * sizeof *q->hist);
+    ibm_history_t *h = &q->hist[q->nhist];
+    h->n = n;
+    h->t = xcalloc((size_t)n, sizeof(double));
+    h->v = xcalloc((size_t)n * 6, sizeof(double));
+    for (int i = 0; i < n; i++) {
+        h->t[i] = rows[7 * i];
+        if (i > 0 && !(h->t[i] > h->t[i - 1])) die("immersed boundary: velocity history times must increase");
+        for (int c = 0; c < 6; c++) h->v[6 * i + c] = rows[7 * i + 1 + c];
+    }
+    return q->nhist++;
+}
+
+void ibm_prescribed_velocity(const ibm_t *ibm, const ibm_sphere_t *s, double t, double u[3], double w[3])
+{
+    const ibm_priv_t *q = ibm_priv(ibm);
+    if (s->history < 0 || s->history >= q->nhist) {
+        memmove(u, s->u, 3 * sizeof(double));
+        memmove(w, s->omega, 3 * sizeof(double));
+        return;
+    }
+    const ibm_history_t *h = &q->hist[s->history];
+    double v[6];
+    if (t <= h->t[0] || h->n == 1) {
+        memcpy(v, h->v, sizeof v);
+    } else if (t >= h->t[h->n - 1]) {
+        memcpy(v, h->v + 6 * (h->n - 1), sizeof v);
+    } else {
+        int i = 0;
+        while (h->t[i + 1] < t) i++;
+        double a = (t - h->t[i]) / (h->t[i + 1] - h->t[i]);
+        for (int c = 0; c < 6; c++) v[c] = (1 - a) * h->v[6 * i + c] + a * h->v[6 * (i + 1) + c];
+    }
+    for (int c = 0; c < 3; c++) {
+        u[c] = v[c];
+        w[c] = v[3 + c];
+    }
+}
+
+/* ---- creation ------------------------------------------------------------------------ */
+
+/* Why sphere s does not fit grid g (NULL if it does). */
+static const char *sphere_misfit(const grid_t *g, const ibm_sphere_t *s)
+{
+    if (!(s->radius > 0)) return "the radius must be > 0";
+    if (s->kind == IBM_FREE && !(s->density > 0)) return "a free sphere needs a density > 0";
+    for (int d = 0; d < g->dim; d++)
+        if (!(s->x[d] >= g->x0[d] && s->x[d] <= g->x0[d] + g->L[d])) return "the centre is outside the domain";
+    if (g->geom == GEOM_AXI) {
+        if (s->x[0] != 0.0 || s->x[2] != 0.0) return "an axisymmetric sphere must be on the axis (x = 0, z = 0)";
+        if (s->u[0] != 0.0 || s->u[2] != 0.0) return "an axisymmetric sphere moves along the axis: u and w must be 0";
+        if (s->omega[0] != 0.0 || s->omega[1] != 0.0 || s->omega[2] != 0.0)
+            return "an axisymmetric sphere cannot rotate (no swirl): omega must be 0";
+    } else if (g->dim == 2) {
+        if (s->u[2] != 0.0 || s->omega[0] != 0.0 || s->omega[1] != 0.0)
+            return "a disc of a 2-D grid moves in the plane: w, omega_x and omega_y must be 0";
+    }
+    return NULL;
+}
+
+ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, int n)
+{
+    const grid_t *g = f->g;
+    if (f->stage_hook || f->stage_end_hook) die("immersed boundary: the fluid's stage hooks are already in use");
+    if (g->nalloc >= INT32_MAX) die("immersed boundary: a field of %ld values is too large for the node lists", g->nalloc);
+    for (int d = 0; d < g->dim; d++)
+        if (g->periodic[d] && g->n[d] > 127 * 1000000) die("immersed boundary: grid too large");
+    ibm_t *ibm = xcalloc(1, sizeof *ibm);
+    ibm_priv_t *q = xcalloc(1, sizeof *q);
+    ibm->f = f;
+    ibm->g = g;
+    ibm->prm = *prm;
+    ibm->n = n;
+    ibm->s = xcalloc((size_t)(n > 0 ? n : 1), sizeof *ibm->s);
+    if (n > 0) memcpy(ibm->s, s, (size_t)n * sizeof *s);
+    ibm->priv = q;
+    for (int p = 0; p < n; p++) {
+        const char *why = sphere_misfit(g, &ibm->s[p]);
+        if (why) die("immersed boundary: sphere %d: %s", p + 1, why);
+        if (prm->force_model == IBM_FORCE_RIGID && ibm->s[p].kind == IBM_FREE &&
+            fabs(ibm->s[p].density - f->prm.rho) < 1e-12 * f->prm.rho)
+            die("immersed boundary: sphere %d: the rigid force model divides by ρp − ρ = 0 (use force_model = "
+                "momentum)",
+                p + 1);
+        if (ibm->s[p].kind != IBM_PRESCRIBED) ibm->s[p].history = -1;
+        if (g->dim == 2) ibm->s[p].x[2] = 0.0;
+    }
+    for (int c = 0; c < g->dim; c++) {
+        q->asum[c] = field_alloc(g);
+        q->aux[c] = field_alloc(g);
+        q->vol[c] = (double *)xcalloc((size_t)g->nxl + 2, sizeof(double)) + 1;
+        q->hcell[c] = (double *)xcalloc((size_t)g->nxl + 2, sizeof(double)) + 1;
+        for (int i = 0; i < g->nxl; i++) {
+            q->vol[c][i] = fluid_cell_volume(f, c, i) * (g->geom == GEOM_AXI ? 2.0 * M_PI : 1.0);
+            double hx = c == 0 ? g->dxc[i] : g->dxf[i];
+            q->hcell[c][i] = g->dim == 3 ? cbrt(hx * g->dy * g->dz) : sqrt(hx * g->dy);
+        }
+    }
+    size_t nn = (size_t)(n > 0 ? n : 1);
+    q->start = xcalloc(nn + 1, sizeof(long));
+    q->nb_start = xcalloc(nn + 1, sizeof(int));
+    q->rdir = g->dim == 3 ? 2 : 1;
+    q->rstride = g->dim == 3 ? 1 : g->sy;
+    q->rstep = g->dim == 3 ? g->dz : g->dy;
+    q->sum = xcalloc(nn * IBM_NSUM, sizeof(double));
+    q->mom_prev = xcalloc(nn * 6, sizeof(double));
+    q->imp_step = xcalloc(nn * 6, sizeof(double));
+    f->stage_hook = ibm_stage_force;
+    f->stage_end_hook = ibm_stage_end;
+    f->hook_ctx = ibm;
+    ibm_update_geometry(ibm);
+    return ibm;
+}
+
+void ibm_free(ibm_t *ibm)
+{
+    if (!ibm) return;
+    ibm_priv_t *q = ibm_priv(ibm);
+    if (ibm->f->hook_ctx == ibm) {
+        ibm->f->stage_hook = NULL;
+        ibm->f->stage_end_hook = NULL;
+        ibm->f->hook_ctx = NULL;
+    }
+    for (int c = 0; c < 3; c++) {
+        free(q->asum[c]);
+        free(q->aux[c]);
+        if (q->vol[c]) free(q->vol[c] - 1);
+        if (q->hcell[c]) free(q->hcell[c] - 1);
+    }
+    for (int h = 0; h < q->nhist; h++) {
+        free(q->hist[h].t);
+        free(q->hist[h].v);
+    }
+    free(q->hist);
+    free(q->runs);
+    free(q->alpha);
+    free(q->nb);
+    free(q->nb_start);
+    free(q->start);
+    free(q->sum);
+    free(q->mom_prev);
+    free(q->imp_step);
+    free(q);
+    free(ibm->s);
+    free(ibm);
+}
+
+/* ---- the case file ------------------------------------------------------------------------ */
+
+/* Read a numeric CSV file with a header line: returns the rows (malloc'd,
+ * ncol per row), the number of rows, the column names in `names`. */
+static double *read_csv(cfg_t *cfg, const char *key, const char *path, int *nrow, int *ncol, char names[][32], int maxcol)
+{
+    FILE *fp = fopen(path, "r");
+    if (!fp) cfg_fail(cfg, "ibm", key, "cannot open %s", path);
+    char line[4096];
+    *ncol = 0;
+    /* header (the first line that is not a comment) */
+    while (fgets(line, sizeof line, fp)) {
+        if (line[0] == '#' || line[strspn(line, " \t\r\n")] == 0) continue;
+        for (char *tok = strtok(line, ", \t\r\n"); tok; tok = strtok(NULL, ", \t\r\n")) {
+            if (*ncol == maxcol) cfg_fail(cfg, "ibm", key, "%s: more than %d columns", path, maxcol);
+            snprintf(names[*ncol], 32, "%s", tok);
+            for (char *c = names[*ncol]; *c; c++) *c = (char)tolower((unsigned char)*c);
+            (*ncol)++;
+        }
+        break;
+    }
+    if (*ncol == 0) cfg_fail(cfg, "ibm", key, "%s: no header line", path);
+    int cap = 64, n = 0, lineno = 1;
+    double *rows = xcalloc((size_t)cap * *ncol, sizeof(double));
+    while (fgets(line, sizeof line, fp)) {
+        lineno++;
+        if (line[0] == '#' || line[strspn(line, " \t\r\n")] == 0) continue;
+        if (n == cap) {
+            cap *= 2;
+            rows = realloc(rows, (size_t)cap * *ncol * sizeof(double));
+        }
+        int k = 0;
+        for (char *tok = strtok(line, ", \t\r\n"); tok; tok = strtok(NULL, ", \t\r\n"), k++) {
+            if (k >= *ncol) cfg_fail(cfg, "ibm", key, "%s:%d: more values than header columns", path, lineno);
+            char *end;
+            double v = strtod(tok, &end);
+            if (*end) {
+                /* a kind column may hold a word */
+                if (!strcmp(tok, "free")) v = IBM_FREE;
+                else if (!strcmp(tok, "fixed")) v = IBM_FIXED;
+                else if (!strcmp(tok, "prescribed")) v = IBM_PRESCRIBED;
+                else cfg_fail(cfg, "ibm", key, "%s:%d: '%s' is not a number", path, lineno, tok);
+            }
+            rows[(long)n * *ncol + k] = v;
+        }
+        if (k != *ncol) cfg_fail(cfg, "ibm", key, "%s:%d: %d values for %d columns", path, lineno, k, *ncol);
+        n++;
+    }
+    fclose(fp);
+    *nrow = n;
+    return rows;
+}
+
+static int column(char names[][32], int ncol, const char *a, const char *b)
+{
+    for (int i = 0; i < ncol; i++)
+        if (!strcmp(names[i], a) || (b && !strcmp(names[i], b))) return i;
+    return -1;
+}
+
+/* Spheres of a CSV file, appended to *s. */
+static void spheres_from_csv(cfg_t *cfg, const char *path, double rho_default, ibm_sphere_t **s, int *n)
+{
+    char names[32][32];
+    int nrow, ncol;
+    double *rows = read_csv(cfg, "spheres_file", path, &nrow, &ncol, names, 32);
+    int cx = column(names, ncol, "x", NULL), cy = column(names, ncol, "y", NULL), cz = column(names, ncol, "z", NULL);
+    int cr = column(names, ncol, "radius", "r"), cd = column(names, ncol, "diameter", "d");
+    int crho = column(names, ncol, "density", "rho");
+    int cu[3] = {column(names, ncol, "u", "vx"), column(names, ncol, "v", "vy"), column(names, ncol, "w", "vz")};
+    int cw[3] = {column(names, ncol, "ox", "wx"), column(names, ncol, "oy", "wy"), column(names, ncol, "oz", "wz")};
+    int ck = column(names, ncol, "kind", NULL), cf = column(names, ncol, "fixed", NULL);
+    if (cx < 0 || cy < 0 || (cr < 0 && cd < 0))
+        cfg_fail(cfg, "ibm", "spheres_file", "%s: the header needs x, y (z in 3-D) and radius or diameter", path);
+    *s = realloc(*s, (size_t)(*n + nrow + 1) * sizeof **s);
+    for (int r = 0; r < nrow; r++) {
+        const double *v = rows + (long)r * ncol;
+        ibm_sphere_t *t = &(*s)[*n + r];
+        memset(t, 0, sizeof *t);
+        t->history = -1;
+        t->x[0] = v[cx];
+        t->x[1] = v[cy];
+        t->x[2] = cz >= 0 ? v[cz] : 0.0;
+        t->radius = cr >= 0 ? v[cr] : 0.5 * v[cd];
+        t->density = crho >= 0 ? v[crho] : rho_default;
+        for (int c = 0; c < 3; c++) {
+            t->u[c] = cu[c] >= 0 ? v[cu[c]] : 0.0;
+            t->omega[c] = cw[c] >= 0 ? v[cw[c]] : 0.0;
+        }
+        t->kind = ck >= 0 ? (ibm_kind_t)(int)v[ck] : (cf >= 0 && v[cf] != 0 ? IBM_FIXED : IBM_FREE);
+        if (t->kind != IBM_FREE && t->kind != IBM_FIXED && t->kind != IBM_PRESCRIBED)
+            cfg_fail(cfg, "ibm", "spheres_file", "%s: row %d: kind must be free (0), fixed (1) or prescribed (2)", path,
+                     r + 1);
+    }
+    *n += nrow;
+    free(rows);
+}
+
+/* Read dataset `name` of `n` × `w` doubles (or ints if is_int) if present. */
+static int h5_read(hid_t f, const char *name, hid_t type, void *buf)
+{
+    if (H5Lexists(f, name, H5P_DEFAULT) <= 0) return 0;
+    hid_t ds = H5Dopen2(f, name, H5P_DEFAULT);
+    herr_t e = H5Dread(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+    H5Dclose(ds);
+    return e >= 0;
+}
+
+/* Spheres of an HDF5 packing (the DEM's packing/checkpoint layout). */
+static void spheres_from_h5(cfg_t *cfg, const char *path, double rho_default, ibm_sphere_t **s, int *n)
+{
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0) cfg_fail(cfg, "ibm", "spheres_file", "cannot open %s as HDF5", path);
+    if (H5Lexists(f, "radius", H5P_DEFAULT) <= 0 || H5Lexists(f, "position", H5P_DEFAULT) <= 0)
+        cfg_fail(cfg, "ibm", "spheres_file", "%s: needs the datasets position [n][3] and radius [n]", path);
+    hid_t ds = H5Dopen2(f, "radius", H5P_DEFAULT), sp = H5Dget_space(ds);
+    hssize_t np = H5Sget_simple_extent_npoints(sp);
+    H5Sclose(sp);
+    H5Dclose(ds);
+    size_t m = (size_t)np + 1;
+    double *x = xcalloc(3 * m, sizeof(double)), *v = xcalloc(3 * m, sizeof(double)), *w = xcalloc(3 * m, sizeof(double));
+    double *r = xcalloc(m, sizeof(double)), *rho = xcalloc(m, sizeof(double));
+    int *fixed = xcalloc(m, sizeof(int));
+    h5_read(f, "position", H5T_NATIVE_DOUBLE, x);
+    h5_read(f, "radius", H5T_NATIVE_DOUBLE, r);
+    int has_rho = h5_read(f, "density", H5T_NATIVE_DOUBLE, rho);
+    h5_read(f, "velocity", H5T_NATIVE_DOUBLE, v);
+    h5_read(f, "omega", H5T_NATIVE_DOUBLE, w);
+    h5_read(f, "fixed", H5T_NATIVE_INT, fixed);
+    H5Fclose(f);
+    *s = realloc(*s, (size_t)(*n + np + 1) * sizeof **s);
+    for (long i = 0; i < np; i++) {
+        ibm_sphere_t *t = &(*s)[*n + i];
+        memset(t, 0, sizeof *t);
+        t->history = -1;
+        t->kind = fixed[i] ? IBM_FIXED : IBM_FREE;
+        t->radius = r[i];
+        t->density = has_rho ? rho[i] : rho_default;
+        for (int c = 0; c < 3; c++) {
+            t->x[c] = x[3 * i + c];
+            t->u[c] = v[3 * i + c];
+            t->omega[c] = w[3 * i + c];
+        }
+    }
+    *n += (int)np;
+    free(x), free(v), free(w), free(r), free(rho), free(fixed);
+}
+
+/* Parse "KIND tag values ..." of key sphereN. */
+static void parse_sphere(cfg_t *cfg, const char *key, const char *text, ibm_sphere_t *t, char *history, size_t nh)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", text);
+    for (char *p = buf; *p; p++)
+        if (*p == ',') *p = ' ';
+    memset(t, 0, sizeof *t);
+    t->history = -1;
+    t->density = -1;
+    history[0] = 0;
+    char *save = NULL, *tok = strtok_r(buf, " \t", &save);
+    if (!tok) cfg_fail(cfg, "ibm", key, "empty");
+    if (!strcmp(tok, "free")) t->kind = IBM_FREE;
+    else if (!strcmp(tok, "fixed")) t->kind = IBM_FIXED;
+    else if (!strcmp(tok, "prescribed")) t->kind = IBM_PRESCRIBED;
+    else cfg_fail(cfg, "ibm", key, "'%s': the first word must be the kind: free, fixed or prescribed", tok);
+    int have_center = 0, have_radius = 0;
+    while ((tok = strtok_r(NULL, " \t", &save))) {
+        int nv;
+        double *dst;
+        if (!strcmp(tok, "center") || !strcmp(tok, "centre") || !strcmp(tok, "position")) {
+            nv = 3, dst = t->x, have_center = 1;
+        } else if (!strcmp(tok, "radius")) {
+            nv = 1, dst = &t->radius, have_radius = 1;
+        } else if (!strcmp(tok, "diameter")) {
+            nv = 1, dst = &t->radius, have_radius = 2;
+        } else if (!strcmp(tok, "density")) {
+            nv = 1, dst = &t->density;
+        } else if (!strcmp(tok, "velocity")) {
+            nv = 3, dst = t->u;
+        } else if (!strcmp(tok, "omega")) {
+            nv = 3, dst = t->omega;
+        } else if (!strcmp(tok, "history")) {
+            char *file = strtok_r(NULL, " \t", &save);
+            if (!file) cfg_fail(cfg, "ibm", key, "history needs a file name");
+            if (t->kind != IBM_PRESCRIBED) cfg_fail(cfg, "ibm", key, "a velocity history needs the kind prescribed");
+            snprintf(history, nh, "%s", file);
+            continue;
+        } else {
+            cfg_fail(cfg, "ibm", key,
+                     "'%s' is not one of center, radius, diameter, density, velocity, omega, history", tok);
+        }
+        for (int i = 0; i < nv; i++) {
+            char *v = strtok_r(NULL, " \t", &save), *end;
+            if (!v) cfg_fail(cfg, "ibm", key, "%s needs %d number%s", tok, nv, nv > 1 ? "s" : "");
+            dst[i] = strtod(v, &end);
+            if (*end || !isfinite(dst[i])) cfg_fail(cfg, "ibm", key, "%s: '%s' is not a number", tok, v);
+        }
+    }
+    if (!have_center) cfg_fail(cfg, "ibm", key, "no center X Y Z");
+    if (!have_radius) cfg_fail(cfg, "ibm", key, "no radius (or diameter)");
+    if (have_radius == 2) t->radius *= 0.5;
+    if (t->kind == IBM_FREE && !(t->density > 0)) cfg_fail(cfg, "ibm", key, "a free sphere needs density RHO > 0");
+}
+
+/* Load a history CSV (t,u,v,w[,ox,oy,oz]) as rows of 7 for ibm_add_history. */
+static double *read_history(cfg_t *cfg, const char *key, const char *path, int *n)
+{
+    char names[16][32];
+    int ncol;
+    double *raw = read_csv(cfg, key, path, n, &ncol, names, 16);
+    int ct = column(names, ncol, "t", "time");
+    const char *vn[6] = {"u", "v", "w", "ox", "oy", "oz"};
+    int cc[6];
+    for (int c = 0; c < 6; c++) cc[c] = column(names, ncol, vn[c], NULL);
+    if (ct < 0 || *n < 1) cfg_fail(cfg, "ibm", key, "%s: needs a column t and at least one row", path);
+    double *rows = xcalloc((size_t)*n * 7, sizeof(double));
+    for (int i = 0; i < *n; i++) {
+        rows[7 * i] = raw[(long)i * ncol + ct];
+        if (i > 0 && !(rows[7 * i] > rows[7 * (i - 1)])) cfg_fail(cfg, "ibm", key, "%s: the times must increase", path);
+        for (int c = 0; c < 6; c++) rows[7 * i + 1 + c] = cc[c] >= 0 ? raw[(long)i * ncol + cc[c]] : 0.0;
+    }
+    free(raw);
+    return rows;
+}
+
+ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f)
+{
+    const grid_t *g = f->g;
+    ibm_params_t prm = ibm_default_params();
+    prm.force_model = (ibm_force_model_t)cfg_enum(cfg, "ibm", "force_model");
+    prm.virtual_mass = cfg_double(cfg, "ibm", "virtual_mass");
+    prm.forcing_iterations = cfg_int(cfg, "ibm", "forcing_iterations");
+    cfg_vec3(cfg, "ibm", "gravity", prm.gravity);
+    prm.retraction = cfg_double(cfg, "ibm", "retraction");
+    prm.forcing_time = cfg_double(cfg, "ibm", "forcing_time");
+    if (g->geom == GEOM_AXI && (prm.gravity[0] != 0.0 || prm.gravity[2] != 0.0))
+        cfg_fail(cfg, "ibm", "gravity", "an axisymmetric gravity must be axial (y)");
+    if (g->dim == 2 && prm.gravity[2] != 0.0) cfg_fail(cfg, "ibm", "gravity", "a 2-D grid has no z direction");
+
+    ibm_sphere_t *s = NULL;
+    int n = 0;
+    char hist[IBM_KEYED_SPHERES][1024];
+    int hist_of[IBM_KEYED_SPHERES], hist_key[IBM_KEYED_SPHERES], nh = 0;
+    for (int k = 1; k <= IBM_KEYED_SPHERES; k++) {
+        char key[24];
+        snprintf(key, sizeof key, "sphere%d", k);
+        if (!cfg_has(cfg, "ibm", key)) continue;
+        s = realloc(s, (size_t)(n + 1) * sizeof *s);
+        char h[1024];
+        parse_sphere(cfg, key, cfg_string(cfg, "ibm", key), &s[n], h, sizeof h);
+        const char *why = sphere_misfit(g, &s[n]);
+        if (why) cfg_fail(cfg, "ibm", key, "%s", why);
+        if (h[0]) {
+            snprintf(hist[nh], sizeof hist[nh], "%s", h);
+            hist_key[nh] = k;
+            hist_of[nh++] = n;
+        }
+        n++;
+    }
+    if (cfg_has(cfg, "ibm", "spheres_file")) {
+        const char *path = cfg_string(cfg, "ibm", "spheres_file");
+        double rho = cfg_has(cfg, "ibm", "density") ? cfg_double(cfg, "ibm", "density") : -1.0;
+        size_t len = strlen(path);
+        int n0 = n;
+        if ((len > 3 && !strcmp(path + len - 3, ".h5")) || (len > 5 && !strcmp(path + len - 5, ".hdf5")))
+            spheres_from_h5(cfg, path, rho, &s, &n);
+        else
+            spheres_from_csv(cfg, path, rho, &s, &n);
+        for (int p = n0; p < n; p++) {
+            if (g->dim == 2) s[p].x[2] = 0.0;
+            if (s[p].kind == IBM_FREE && !(s[p].density > 0))
+                cfg_fail(cfg, "ibm", cfg_has(cfg, "ibm", "density") ? "density" : "spheres_file",
+                         "sphere %d of %s is free and has no density > 0 (give a density column or [ibm] density)",
+                         p - n0 + 1, path);
+            const char *why = sphere_misfit(g, &s[p]);
+            if (why) cfg_fail(cfg, "ibm", "spheres_file", "sphere %d of %s: %s", p - n0 + 1, path, why);
+        }
+    }
+    if (n == 0) cfg_fail(cfg, "ibm", "sphere1", "the [ibm] section defines no sphere (sphere1.. or spheres_file)");
+    for (int p = 0; p < n; p++)
+        if (prm.force_model == IBM_FORCE_RIGID && s[p].kind == IBM_FREE &&
+            fabs(s[p].density - f->prm.rho) < 1e-12 * f->prm.rho)
+            cfg_fail(cfg, "ibm", "force_model", "rigid divides by ρp − ρ = 0 for sphere %d (neutrally buoyant): use momentum",
+                     p + 1);
+    ibm_t *ibm = ibm_create(f, &prm, s, n);
+    for (int h = 0; h < nh; h++) {
+        int nrow;
+        char key[24];
+        snprintf(key, sizeof key, "sphere%d", hist_key[h]);
+        double *rows = read_history(cfg, key, hist[h], &nrow);
+        ibm_sphere_t *sp = &ibm->s[hist_of[h]];
+        sp->history = ibm_add_history(ibm, nrow, rows);
+        ibm_prescribed_velocity(ibm, sp, f->time, sp->u, sp->omega);
+        free(rows);
+    }
+    if (nh > 0) ibm_update_geometry(ibm);
+    free(s);
+    return ibm;
+}

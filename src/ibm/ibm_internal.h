@@ -1,0 +1,91 @@
+/* ibm_internal.h — private state of the immersed boundary, shared by the
+ * files of src/ibm/ only (the interface is include/ibm.h). */
+#ifndef IBMDEM_IBM_INTERNAL_H
+#define IBMDEM_IBM_INTERNAL_H
+
+#include <stdint.h>
+
+#include "ibm.h"
+
+/* A run of consecutive nodes of one velocity component inside the band
+ * or the interior of one sphere, along the fastest storage direction (z in
+ * 3-D, y in 2-D): node q = 0..len−1 is at storage index m0 + q·stride, at
+ * offset r0 + q·h_run e_run from the sphere's centre (periodic image
+ * applied), with solid fraction alpha[a0 + q].  A sphere + band is convex,
+ * so a grid line meets it in one segment (two if a periodic face cuts it). */
+typedef struct {
+    double r0[3];
+    int32_t m0;     /* G_IDX of the first node */
+    int32_t a0;     /* index of its α in the alpha array */
+    int16_t len;
+    uint8_t c;      /* velocity component */
+    uint8_t shared; /* another sphere's band may reach a node of the run */
+} ibm_run_t;
+
+typedef struct {
+    int n;
+    double *t;      /* n times */
+    double *v;      /* n × 6: u, v, w, ωx, ωy, ωz */
+} ibm_history_t;
+
+/* Per-sphere sums reduced over the ranks. */
+enum { IBM_FIMP = 0, IBM_TIMP = 3, IBM_MOM = 6, IBM_ANG = 9, IBM_NSUM = 12 };
+
+typedef struct {
+    /* runs: sphere p owns runs[start[p] .. start[p+1]) */
+    ibm_run_t *runs;
+    long nruns, cap_runs;
+    long *start;
+    double *alpha;
+    long nalpha, cap_alpha, nshared;
+    int rdir;          /* run direction (2 in 3-D, 1 in 2-D), its stride and spacing */
+    long rstride;
+    double rstep;
+    /* neighbours of each sphere: the spheres (periodic images included)
+     * whose band may reach its nodes, nb[nb_start[p] .. nb_start[p+1]), each
+     * with the offset of that image's centre from sphere p's */
+    struct ibm_neighbour {
+        int o;
+        double d[3];
+    } *nb;
+    int *nb_start;
+    long nb_cap;
+    /* dense scratch of each component: Σ_p α_p, then Σ_p α_p U_p and the
+     * impulse of the forcing (zero outside the node lists between uses) */
+    double *asum[3], *aux[3];
+    /* control volume of each unknown by local x index (−1..nxl), times 2π
+     * in axisymmetric geometry: the integrals are over the whole volume */
+    double *vol[3];
+    double *hcell[3];  /* cell size h of the unknowns by local x index (see alpha.c) */
+    /* per-sphere sums: forcing impulse ∫f dV Δt_k and its moment, fluid
+     * momentum ∫α u dV and angular momentum ∫α r × u dV */
+    double *sum;       /* n × IBM_NSUM, this rank, then reduced */
+    double *mom_prev;  /* n × 6: momentum and angular momentum at the end of the last stage (reduced) */
+    double *imp_step;  /* n × 6: Σ over the stages of the hydrodynamic impulse (force and torque × Δt_k) */
+    double t_step;     /* Σ Δt_k of the stages so far in this step */
+    double t_stage0;   /* fluid time at the start of the step */
+    int nhist;
+    ibm_history_t *hist;
+} ibm_priv_t;
+
+static inline ibm_priv_t *ibm_priv(const ibm_t *ibm) { return (ibm_priv_t *)ibm->priv; }
+
+/* alpha.c */
+void ibm_build_nodes(ibm_t *ibm);
+/* Local x index of storage index m. */
+static inline int ibm_node_i(const grid_t *g, long m) { return (int)(m / g->sx) - 1; }
+/* Rigid-body velocity component c of sphere s at offset r. */
+static inline double ibm_rigid_velocity(const ibm_sphere_t *s, int c, const double r[3])
+{
+    switch (c) {
+    case 0: return s->u[0] + s->omega[1] * r[2] - s->omega[2] * r[1];
+    case 1: return s->u[1] + s->omega[2] * r[0] - s->omega[0] * r[2];
+    default: return s->u[2] + s->omega[0] * r[1] - s->omega[1] * r[0];
+    }
+}
+/* forcing.c */
+void ibm_momentum(ibm_t *ibm, double *out6);
+void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx);
+void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx);
+
+#endif
