@@ -49,7 +49,9 @@ typedef struct {
 struct fluid {
     grid_t *g;
     fluid_params_t prm;
-    double *u[3];         /* velocity components on their faces (u[2] NULL in 2-D) */
+    double *u[3];         /* velocity components on their faces (u[2] NULL in 2-D); fluid_step
+                           * swaps these arrays with its Runge–Kutta storage at every stage:
+                           * read f->u[c] afresh, never keep the pointer across a step */
     double *p;            /* kinematic pressure relative to hydrostatic, cell centres */
     double time;
     long step;

@@ -38,6 +38,7 @@ typedef struct {
     double mg_tol;     /* multigrid: relative residual tolerance */
     int mg_max_cycles; /* multigrid: maximum V-cycles */
     int mg_pre, mg_post; /* multigrid: smoothing sweeps */
+    int fftw_measure;    /* fft: plan with FFTW_MEASURE (faster, not bit-reproducible run to run) */
 } poisson_opts_t;
 
 typedef struct poisson poisson_t;
@@ -68,8 +69,16 @@ struct poisson {
     double cy, cz;        /* 1/dy², 1/dz² (cz = 0 in 2-D) */
     const poisson_backend_t *backend;
     void *impl;
+    /* set by a back-end's create() when its solve() handles a singular
+     * problem (λ = 0, no Dirichlet face) itself: it removes the weighted mean
+     * of b and returns x of zero weighted mean, so poisson_solve need not
+     * copy b (otherwise poisson_solve does it around the back-end) */
+    int backend_handles_singular;
     /* statistics of the last solve */
-    double last_residual; /* relative residual ||b − A x|| / ||b|| (measured) */
+    double last_residual; /* relative residual ||b − A x|| / ||b|| (measured), or −1 when the
+                           * method does not measure it (the direct solver: round-off by
+                           * construction, measured by its tests; one more operator
+                           * application costs 15 % of its solve at 128³, measured) */
     int last_iterations;  /* V-cycles (multigrid) or 1 (direct) */
 };
 
@@ -99,6 +108,13 @@ void poisson_fill_ghosts(const poisson_t *p, double *x);
 
 /* Is (i,j,k) (local) an unknown of this location? */
 int poisson_is_unknown(const poisson_t *p, int i, int j, int k);
+
+/* Weight of the x unknown ig (global) in the volume-weighted inner product
+ * for which L is symmetric: Σ w (L x) = 0 for every x when L is singular. */
+double poisson_x_weight(const poisson_t *p, int ig);
+/* Weighted mean of the unknowns of f (global), and f += c on the unknowns. */
+double poisson_weighted_mean(const poisson_t *p, const double *f);
+void poisson_add_constant(const poisson_t *p, double *f, double c);
 
 /* Relative residual ||b − (L − λI)x||₂ / ||b||₂ over the unknowns (uses a
  * scratch field; for tests and diagnostics). */

@@ -144,6 +144,12 @@ void sim_add_field_writer(sim_t *s, sim_field_writer_t fn, void *ctx);
 
 /* The fluid part (sim_fluid.c): built when the case has a [fluid] section. */
 void sim_add_fluid(sim_t *s, cfg_t *cfg);
+/* The DEM part (sim_dem.c): built when the case has a [particles] section. */
+void sim_add_dem(sim_t *s, cfg_t *cfg);
+/* The DEM engine of the run (its packing prepared), NULL without particles. */
+struct dem *sim_dem_engine(sim_t *s);
+/* The pore-network fluid (sim_porenet.c): built when the case has a [porenet] section. */
+void sim_add_porenet(sim_t *s, cfg_t *cfg);
 /* The immersed-boundary part (sim_ibm.c): built when the case has an [ibm]
  * section; needs the fluid (its stage hooks do the work). */
 void sim_add_ibm(sim_t *s, cfg_t *cfg);

@@ -1,8 +1,10 @@
 #!/bin/bash
 # Install the Debian packages ibmdem needs, only those that are missing.
+# DEPS_PKGS replaces the list (bench/deps_bench.sh: the codes the benchmarks compare with).
 set -e
-PKGS="make gcc pkg-config libopenmpi-dev openmpi-bin libfftw3-dev libfftw3-mpi-dev libhdf5-openmpi-dev
-      hdf5-tools libgsl-dev libinih-dev libcmocka-dev python3-numpy python3-matplotlib python3-h5py"
+PKGS=${DEPS_PKGS:-"make gcc pkg-config libopenmpi-dev openmpi-bin libfftw3-dev libfftw3-mpi-dev libhdf5-openmpi-dev
+      hdf5-tools libgsl-dev libinih-dev libcmocka-dev libqhull-dev libsuitesparse-dev libopenblas0-serial
+      python3-numpy python3-matplotlib python3-h5py"}
 missing=""
 for p in $PKGS; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"

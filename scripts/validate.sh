@@ -57,6 +57,52 @@ sys.exit(0 if ok else 1)
 PY
 fi
 
+# --- porenet: permeameter cases (fixed packings), summary values, ParaView
+d=$(mktemp -d)
+if "$BUILD/ibmdem" run cases/permeameter/periodic.ini --out "$d/per" >/dev/null 2>&1 &&
+   "$BUILD/ibmdem" run cases/permeameter/permeameter.ini --out "$d/wal" >/dev/null 2>&1; then
+    /usr/bin/python3 - "$d" <<'PY' || fail "porenet permeameter"
+import json, sys
+d = sys.argv[1]
+per = json.load(open(d + "/per/summary.json"))["porenet"]
+wal = json.load(open(d + "/wal/summary.json"))["porenet"]
+# prototype (catalano_pfv.md section 6) on the same packing: kappa/d^2 = 1.2223e-3, d = 2 mean r
+import numpy as np
+r = np.loadtxt("tests/data/porenet/proto_N1000_phi0.60_pd0.05.txt")[:, 3]
+k = per["permeability_z"] / (2 * r.mean())**2
+q = wal["flux_in"]
+ok = abs(k / 1.222330e-3 - 1) < 0.03 and abs(q["z_lo"] + q["z_hi"]) < 1e-10 * q["z_lo"]
+print("porenet: periodic kappa/d^2 = %.6e (prototype 1.222330e-3); walled Qin + Qout = %.1e" % (k, q["z_lo"] + q["z_hi"]))
+sys.exit(0 if ok else 1)
+PY
+    if command -v pvpython >/dev/null; then
+        pvpython postproc/check_porenet_paraview.py "$d/wal/porenet.xmf" || fail "porenet paraview"
+    fi
+else
+    fail "porenet runs"
+fi
+rm -rf "$d"
+
+
+# --- fluid: lid-driven cavity series, Re = 100 (Crank-Nicolson) and Re = 1000
+# (explicit) on 64^2, 128^2, 256^2 to steady state, Richardson-extrapolated with
+# the observed order and compared with Ghia et al. (1982) and with the extrema of
+# Botella & Peyret (1998) / Marchi et al. (2009) (cases/cavity/*.csv).  Measured
+# (docs/validation.md): orders 2.06 and 1.89, extrapolated extrema within 1.2e-5
+# and 1.0e-4 of the references.  Asserts order > 1.6, the limit closer to the
+# reference than half the 256^2 error, the limit within 0.012 / 0.02 of Ghia.
+# About 10 minutes on one quiet core (256^2 at Re = 1000: 20 600 steps).
+section "fluid: cavity Re = 100 and 1000, 64^2 to 256^2, Richardson extrapolation"
+IBMDEM_VALIDATE=1 $MPIRUN -np 1 "$BUILD/tests/test_fluid_cavity" >"$OUT/fluid_cavity.txt" 2>&1
+rc=$?
+cat "$OUT/fluid_cavity.txt"
+[ "$rc" = 0 ] || fail "fluid cavity series"
+
+# --- dem: full column collapse and rough inclined plane (scripts/validate_dem.sh)
+section "dem: column collapse and inclined plane (full size)"
+BUILD=$BUILD OUT=$OUT bash scripts/validate_dem.sh || fail "dem cases"
+
+
 # --- ibm: the immersed boundary at full size (tests/test_ibm_*.c in their full modes).
 #  1. the settling sphere of the seed, axisymmetric, D/dx = 20, r <= 10 D, 40 D long,
 #     dt sqrt(g/D) = 0.04: initial acceleration within 5 % of (rho_p - rho) g/(rho_p + rho/2),
@@ -73,7 +119,7 @@ IBM_FULL=1 $MPIRUN -np 2 "$BUILD/tests/test_ibm_stokes" || fail "ibm Stokes drag
 section "ibm: settling sphere, 3-D, D/dx = 16"
 IBM_FULL3D=1 IBM_TESTS=test_settling_3d $MPIRUN -np 2 "$BUILD/tests/test_ibm_settling" || fail "ibm settling 3-D"
 
-# (fluid, poisson, dem: add sections here)
+# (further modules: add sections here)
 
 echo
 if [ -n "$failed" ]; then echo "validate: FAILED:$failed"; exit 1; fi

@@ -88,7 +88,7 @@ static const char *vname[2] = {"explicit", "implicit"};
 /* Plane Couette flow between walls moving at −0.5 and 1 (walls in x,
  * stretched tanh_both, flow along y), from rest: after t = 4H²/ν the slowest
  * mode has decayed by e^{−4π²} ≈ 1e-17, and the profile must be the exact
- * linear one to round-off (1e-12 of the wall speed), with the wall shear
+ * linear one to round-off (1e-12 of the wall speed; ft_exact_tol), with the wall shear
  * exact and D u < 1e-12 (relative). */
 static void test_couette_stretched(void **state)
 {
@@ -105,8 +105,8 @@ static void test_couette_stretched(void **state)
         double e = run_channel(text, &l, 4.0, &se, &div, &steps);
         msg("  Couette, stretched walls in x (%s, %d steps): max error %.2e, wall shear error %.2e, div %.1e\n",
             vname[impl], steps, e, se, div);
-        assert_true(e < 1e-12);
-        assert_true(se < 1e-12);
+        assert_true(e < ft_exact_tol());
+        assert_true(se < ft_exact_tol());
         assert_true(div < 1e-12);
     }
 }
@@ -133,8 +133,8 @@ static void test_poiseuille_uniform(void **state)
         msg("  plane Poiseuille, uniform (%s, %d steps): max |u_h − u − fh²/8ν| = %.2e (u_max = %.3f, shift %.2e); "
             "wall shear error %.2e; div %.1e\n",
             vname[impl], steps, e, fb / (8 * nu), l.shift, se, div);
-        assert_true(e < 1e-12);
-        assert_true(se < 1e-12);
+        assert_true(e < ft_exact_tol());
+        assert_true(se < ft_exact_tol());
         assert_true(div < 1e-12);
     }
 }
@@ -159,7 +159,7 @@ static void test_poiseuille_stretched(void **state)
         e[r] = run_channel(text, &l, 4.0, &se, &div, NULL);
         msg("  plane Poiseuille, stretched, %d cells: max error %.3e (u_max %.3f), wall shear error %.2e, div %.1e\n",
             nx, e[r], fb / (8 * nu), se, div);
-        assert_true(se < 1e-12);
+        assert_true(se < ft_exact_tol());
         assert_true(div < 1e-12);
     }
     double o = conv_order(e[0], e[1], 2);
@@ -195,9 +195,9 @@ static void test_hagen_poiseuille(void **state)
             msg("  Hagen-Poiseuille, %s r (%s, %d steps): max |u_h − u − shift| = %.2e (u_max = %.2f), wall shear "
                 "error %.2e, div %.1e\n",
                 st ? "stretched" : "uniform", vname[impl], steps, e, fb / (4 * nu), se, div);
-            if (!st) assert_true(e < 1e-12);
+            if (!st) assert_true(e < ft_exact_tol());
             else assert_true(e < 0.01 * fb / (4 * nu)); /* second order, ~h² of u_max */
-            assert_true(se < 1e-12);
+            assert_true(se < ft_exact_tol());
             assert_true(div < 1e-12);
         }
 }

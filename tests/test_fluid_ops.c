@@ -4,6 +4,7 @@
  * the Laplacian of poisson.c, and the [fluid] input checks.
  * RANKS: 1 2
  */
+#include "../src/fluid/fluid_internal.h" /* fluid_rhs, the fused right-hand side */
 #include "fluidtest.h"
 #include "modules.h"
 #include "testutil.h"
@@ -397,50 +398,52 @@ static void test_viscous_couette(void **state)
 
 /* The viscous term is ν times THE Laplacian of poisson.c: equal to
  * poisson_apply (homogeneous BCs) plus the moving-wall terms 2U·c_wall
- * (c_wall = 1/Δy² at a y wall, 1/(Δx_c Δx_f) at an x wall), to round-off. */
+ * (c_wall = 1/Δy² or 1/Δz² at a y or z wall, 1/(Δx_c Δx_f) at an x wall), to
+ * round-off; and the fused right-hand side of the time step (fluid_rhs) has
+ * the same viscous part.  2-D: moving walls on all sides, stretched x; 3-D:
+ * moving no-slip x walls (stretched), free-slip y, moving no-slip z. */
 static double smooth_fn(int c, const double x[3], double t, const void *ctx)
 {
     (void)t;
     (void)ctx;
-    return c == 0 ? sin(2.1 * x[0] + 0.3) * cos(1.7 * x[1]) + x[1] : cos(1.3 * x[0]) * sin(2.5 * x[1] + 0.2) - x[0];
+    if (c == 0) return sin(2.1 * x[0] + 0.3) * cos(1.7 * x[1]) * cos(x[2]) + x[1];
+    if (c == 1) return cos(1.3 * x[0]) * sin(2.5 * x[1] + 0.2) * sin(x[2] + 1) - x[0];
+    return cos(0.7 * x[0] + x[1]) * sin(1.9 * x[2]);
 }
 
-static void test_viscous_is_poisson_operator(void **state)
+static void check_viscous_identity(geom_t geom, const bc_t *bc)
 {
-    int n[3] = {16, 12, 1};
-    double L[3] = {1, 1, 1};
-    bc_t bc = {0};
-    bc.type[0][0] = bc.type[0][1] = bc.type[1][0] = bc.type[1][1] = BC_NOSLIP;
-    bc.vel[1][0][0] = 0.2;
-    bc.vel[1][1][0] = 1.0;
-    bc.vel[0][0][1] = 0.3;
-    bc.vel[0][1][1] = -0.7;
-    grid_t *g = grid_create(GEOM_2D, n, L, NULL, &bc, STRETCH_TANH_BOTH, 2.0, MPI_COMM_WORLD);
+    int n[3] = {16, 12, geom == GEOM_3D ? 10 : 1};
+    double L[3] = {1, 1.2, 0.9};
+    grid_t *g = grid_create(geom, n, L, NULL, bc, STRETCH_TANH_BOTH, 2.0, MPI_COMM_WORLD);
     double nu = 0.37;
     fluid_params_t prm = ft_params(nu, 0);
     fluid_t *f = fluid_create(g, &prm);
     ft_set_velocity(f, smooth_fn, 0, NULL);
-    double *V[3] = {field_alloc(g), field_alloc(g), NULL};
+    double *V[3] = {field_alloc(g), field_alloc(g), field_alloc(g)}, *R[3] = {field_alloc(g), field_alloc(g), field_alloc(g)};
     fluid_viscous(f, V);
-    double m = 0, s = 0;
-    for (int c = 0; c < 2; c++) {
+    fluid_rhs(f, 0.0, nu, R);
+    double m = 0, mr = 0, s = 0;
+    for (int c = 0; c < g->dim; c++) {
         poisson_t *p = poisson_create_operator(g, (var_loc_t)c);
         double *x = field_alloc(g), *y = field_alloc(g);
         field_copy(g, x, f->u[c]);
         poisson_apply(p, 0.0, x, y);
         FT_FOR_UNKNOWNS(g, c, i, j, k)
         {
-            int ig = i + g->ix0;
+            int idx[3] = {i + g->ix0, j, k};
             double w = 0;
-            if (c == 0) {
-                if (j == 0) w += 2 * bc.vel[1][0][0] / (g->dy * g->dy);
-                if (j == g->n[1] - 1) w += 2 * bc.vel[1][1][0] / (g->dy * g->dy);
-            } else {
-                if (ig == 0) w += 2 * bc.vel[0][0][1] / (g->gdxc[-1] * g->gdxf[0]);
-                if (ig == g->n[0] - 1) w += 2 * bc.vel[0][1][1] / (g->gdxc[g->n[0] - 1] * g->gdxf[g->n[0] - 1]);
+            for (int d = 0; d < g->dim; d++) {
+                if (d == c) continue;
+                int nd = g->n[d];
+                double clo = d == 0 ? 1 / (g->gdxc[-1] * g->gdxf[0]) : d == 1 ? 1 / (g->dy * g->dy) : 1 / (g->dz * g->dz);
+                double chi = d == 0 ? 1 / (g->gdxc[nd - 1] * g->gdxf[nd - 1]) : clo;
+                if (idx[d] == 0 && bc->type[d][0] == BC_NOSLIP) w += 2 * bc->vel[d][0][c] * clo;
+                if (idx[d] == nd - 1 && bc->type[d][1] == BC_NOSLIP) w += 2 * bc->vel[d][1][c] * chi;
             }
             long q = G_IDX(g, i, j, k);
             m = fmax(m, fabs(V[c][q] - nu * (y[q] + w)));
+            mr = fmax(mr, fabs(V[c][q] - R[c][q]));
             s = fmax(s, fabs(V[c][q]));
         }
         free(x);
@@ -448,13 +451,39 @@ static void test_viscous_is_poisson_operator(void **state)
         poisson_free(p);
     }
     m = grid_max(g, m);
+    mr = grid_max(g, mr);
     s = grid_max(g, s);
-    msg("  viscous term vs ν(poisson_apply + wall terms): max difference %.2e of %.2e\n", m, s);
+    msg("  %d-D viscous term vs ν(poisson_apply + wall terms): max difference %.2e; vs the fused right-hand side "
+        "%.2e; of max %.2e\n",
+        g->dim, m, mr, s);
     assert_true(m < 1e-13 * s);
-    free(V[0]);
-    free(V[1]);
+    assert_true(mr < 1e-13 * s);
+    for (int c = 0; c < 3; c++) {
+        free(V[c]);
+        free(R[c]);
+    }
     fluid_free(f);
     grid_free(g);
+}
+
+static void test_viscous_is_poisson_operator(void **state)
+{
+    bc_t bc = {0};
+    bc.type[0][0] = bc.type[0][1] = bc.type[1][0] = bc.type[1][1] = BC_NOSLIP;
+    bc.vel[1][0][0] = 0.2;
+    bc.vel[1][1][0] = 1.0;
+    bc.vel[0][0][1] = 0.3;
+    bc.vel[0][1][1] = -0.7;
+    check_viscous_identity(GEOM_2D, &bc);
+    memset(&bc, 0, sizeof bc);
+    bc.type[0][0] = bc.type[0][1] = BC_NOSLIP;
+    bc.type[1][0] = bc.type[1][1] = BC_FREESLIP;
+    bc.type[2][0] = bc.type[2][1] = BC_NOSLIP;
+    bc.vel[0][0][1] = 0.3;
+    bc.vel[0][1][2] = -0.4;
+    bc.vel[2][1][0] = 1.0;
+    bc.vel[2][0][1] = 0.5;
+    check_viscous_identity(GEOM_3D, &bc);
 }
 
 /* ---- bad input -------------------------------------------------------- */

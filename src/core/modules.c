@@ -1,10 +1,12 @@
 /* modules.c — one place that knows every module's schema of keys. */
 #include "modules.h"
 
+#include "dem.h"
 #include "fluid.h"
 #include "ibm.h"
 #include "grid.h"
 #include "poisson.h"
+#include "porenet.h"
 #include "sim.h"
 
 void modules_register_keys(void)
@@ -12,6 +14,8 @@ void modules_register_keys(void)
     grid_register_keys();
     poisson_register_keys();
     fluid_register_keys();
+    porenet_register_keys();
     ibm_register_keys();
     sim_register_keys();
+    dem_register_keys();
 }

@@ -160,10 +160,11 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
         if (!s->fluid) cfg_fail(cfg, "ibm", "sphere1", "an immersed boundary needs a fluid: the case has no [fluid] section");
         sim_add_ibm(s, cfg);
     }
-    /* (particles / DEM, pore network: add here) */
+    if (cfg_has_section(cfg, "particles")) sim_add_dem(s, cfg);
+    if (cfg_has_section(cfg, "porenet")) sim_add_porenet(s, cfg);
 
     if (s->npart == 0) {
-        if (mpi_rank() == 0) fprintf(stderr, "%s: nothing to simulate: the case has no [fluid] section (with at least one key)\n", cfg_path(cfg));
+        if (mpi_rank() == 0) fprintf(stderr, "%s: nothing to simulate: the case has no [fluid] or [particles] section (with at least one key)\n", cfg_path(cfg));
         MPI_Finalize();
         exit(2);
     }

@@ -13,6 +13,8 @@
  *   free-slip and axis: ghost = interior               (zero normal gradient;
  *                       on the axis u_z is even in r)
  */
+#include <string.h>
+
 #include "fluid_internal.h"
 
 /* ghost value of a tangential component at a face of type t with wall velocity U */
@@ -21,12 +23,39 @@ static inline double tangential_ghost(bc_type_t t, double U, double interior)
     return t == BC_NOSLIP ? 2.0 * U - interior : interior;
 }
 
-void fluid_fill_ghosts_component(const fluid_t *f, int c, double *u)
+/* Ghost planes in x of nf fields at once (one message each way instead of
+ * nf): the planes i = 0 and nxl−1 (with their y/z ghosts) go to the
+ * neighbours' i = nxl and −1, as grid_halo_x does for one field. */
+static void halo_x_fields(const fluid_t *f, double *const *u, int nf)
+{
+    const grid_t *g = f->g;
+    if (g->nranks == 1 || nf == 1) {
+        for (int c = 0; c < nf; c++) grid_halo_x(g, u[c]);
+        return;
+    }
+    fluid_priv_t *q = fluid_priv(f);
+    long np = g->sx, off_first = G_IDX(g, 0, -1, -g->gz), off_last = G_IDX(g, g->nxl - 1, -1, -g->gz);
+    long off_lo = G_IDX(g, -1, -1, -g->gz), off_hi = G_IDX(g, g->nxl, -1, -g->gz);
+    double *sb = q->halo_buf, *rb = q->halo_buf + nf * np;
+    size_t bytes = (size_t)np * sizeof(double);
+    for (int c = 0; c < nf; c++) memcpy(sb + c * np, u[c] + off_last, bytes);
+    MPI_Sendrecv(sb, (int)(nf * np), MPI_DOUBLE, g->right, 21, rb, (int)(nf * np), MPI_DOUBLE, g->left, 21, g->comm,
+                 MPI_STATUS_IGNORE);
+    if (g->left != MPI_PROC_NULL)
+        for (int c = 0; c < nf; c++) memcpy(u[c] + off_lo, rb + c * np, bytes);
+    for (int c = 0; c < nf; c++) memcpy(sb + c * np, u[c] + off_first, bytes);
+    MPI_Sendrecv(sb, (int)(nf * np), MPI_DOUBLE, g->left, 22, rb, (int)(nf * np), MPI_DOUBLE, g->right, 22, g->comm,
+                 MPI_STATUS_IGNORE);
+    if (g->right != MPI_PROC_NULL)
+        for (int c = 0; c < nf; c++) memcpy(u[c] + off_hi, rb + c * np, bytes);
+}
+
+/* Boundary ghosts of component c (after the halo exchange). */
+static void fill_boundary_ghosts(const fluid_t *f, int c, double *u)
 {
     const grid_t *g = f->g;
     const bc_t *bc = &g->bc;
     int nxl = g->nxl, ny = g->n[1], nz = g->n[2], gz = g->gz;
-    grid_halo(g, u);
 
     /* x faces: only the ranks that own them */
     if (!g->periodic[0]) {
@@ -81,7 +110,10 @@ void fluid_fill_ghosts_component(const fluid_t *f, int c, double *u)
 
 void fluid_apply_bc(fluid_t *f)
 {
-    for (int c = 0; c < fluid_ncomp(f->g); c++) fluid_fill_ghosts_component(f, c, f->u[c]);
+    int nc = fluid_ncomp(f->g);
+    for (int c = 0; c < nc; c++) grid_halo_yz(f->g, f->u[c]);
+    halo_x_fields(f, f->u, nc);
+    for (int c = 0; c < nc; c++) fill_boundary_ghosts(f, c, f->u[c]);
 }
 
 /* The pressure (and its correction φ) has zero normal gradient at walls and

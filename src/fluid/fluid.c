@@ -73,14 +73,14 @@ fluid_t *fluid_create(grid_t *g, const fluid_params_t *prm)
     int nc = fluid_ncomp(g);
     for (int c = 0; c < nc; c++) {
         f->u[c] = field_alloc(g);
-        q->dudt[c] = field_alloc(g);
-        q->dudt_old[c] = field_alloc(g);
+        q->h[c] = field_alloc(g);
+        q->spare[c] = field_alloc(g);
         q->pv[c] = prm->implicit_viscous ? poisson_create(g, (var_loc_t)c, &prm->poisson)
                                          : poisson_create_operator(g, (var_loc_t)c);
     }
     f->p = field_alloc(g);
-    q->phi = field_alloc(g);
     q->work = field_alloc(g);
+    q->halo_buf = xcalloc((size_t)6 * g->sx, sizeof(double));
     q->pp = poisson_create(g, VAR_P, &prm->poisson);
 
     int nxl = g->nxl;
@@ -103,13 +103,13 @@ void fluid_free(fluid_t *f)
     fluid_priv_t *q = fluid_priv(f);
     for (int c = 0; c < 3; c++) {
         free(f->u[c]);
-        free(q->dudt[c]);
-        free(q->dudt_old[c]);
+        free(q->h[c]);
+        free(q->spare[c]);
         poisson_free(q->pv[c]);
     }
     free(f->p);
-    free(q->phi);
     free(q->work);
+    free(q->halo_buf);
     poisson_free(q->pp);
     free(q->af - 1);
     free(q->ac - 1);

@@ -9,10 +9,13 @@ typedef struct {
     poisson_t *pp;         /* VAR_P: projection (L = D·G) */
     poisson_t *pv[3];      /* L of each velocity location: the Crank–Nicolson Helmholtz
                             * solvers when implicit, the operator alone when explicit */
-    double *dudt[3];       /* explicit right-hand side of the current RK stage */
-    double *dudt_old[3];   /* ... of the previous stage (the ζ term) */
-    double *phi;           /* pressure correction */
-    double *work;          /* scratch */
+    /* Runge–Kutta storage, rotated with u[c] at every stage (fluid_step):
+     * h[c] holds H of the previous stage (the ζ term) and receives u*;
+     * spare[c] receives H of this stage. */
+    double *h[3];
+    double *spare[3];
+    double *work;          /* scratch: the pressure correction φ, the Helmholtz right-hand sides */
+    double *halo_buf;      /* send and receive buffers of the combined x halo (2 × 3 planes) */
     /* metric of the local x range, index −1..nxl (stored at +1): face and
      * centre area factors (r in axisymmetric geometry, 1 otherwise) */
     double *af, *ac;
@@ -38,21 +41,38 @@ static inline int fluid_iend(const grid_t *g, int c)
     return e < g->nxl ? e : g->nxl;
 }
 static inline int fluid_ncomp(const grid_t *g) { return g->dim; }
+/* The unknowns of one component at local x index i as contiguous lines:
+ * (j, k = 0..nk−1) for each j in 3-D, (j = 0..nj−1, k = 0) in 2-D, where the
+ * j stride is 1 (nz = 1, no z ghosts).  Declares c0 (first index) and len. */
+#define FLUID_FOR_LINES(g, i, nj, nk, c0, len)                                          \
+    for (int jl_ = 0, nl_ = (g)->dim == 3 ? (nj) : 1; jl_ < nl_; jl_++)                \
+        for (long c0 = G_IDX(g, i, (g)->dim == 3 ? jl_ : 0, 0), len = (g)->dim == 3 ? (nk) : (nj), once_ = 1; \
+             once_; once_ = 0)
 
-/* advection.c */
-void fluid_advection_add(const fluid_t *f, double scale, double *const out[3]);
+/* max without the NaN rules of fmax (which the compiler cannot inline) */
+static inline double dmax(double a, double b) { return a > b ? a : b; }
+
+/* advection.c: out = ca·∇·(u⊗u) + cv·L u, one fused sweep */
+void fluid_rhs(const fluid_t *f, double ca, double cv, double *const out[3]);
+/* the same, H = ca·N + cv·L u, with the predictor in the same sweep:
+ * US[c] (H_old on entry) ← u + dg·H + dz·H_old + adt·(f − G p) + ce·L u;
+ * H_old is not read when dz = 0, H not stored when H is NULL */
+void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
+                       double *const H[3], double *const US[3]);
 /* viscous.c */
 void fluid_laplacian_add(const fluid_t *f, int c, const double *u, double scale, double *out);
 void fluid_wall_terms_add(const fluid_t *f, int c, double scale, double *out);
 void fluid_viscous_setup(fluid_t *f);
 /* bc.c */
-void fluid_fill_ghosts_component(const fluid_t *f, int c, double *u);
 void fluid_fill_pressure_ghosts(const fluid_t *f, double *p);
 /* timestep.c: max over cells of Σ_d |u_d|/Δ_d (|u_d| the larger of the two faces) */
 double fluid_convective_rate(const fluid_t *f);
-/* diagnostics.c: ke, div_max, cfl of f->diag from the current field */
-void fluid_update_diagnostics(fluid_t *f);
+/* diagnostics.c: ke, div_max, cfl of f->diag from the current field (stats:
+ * Σ V u² and max |u| of this rank if already known, else NULL);
+ * div = scale · D u at the cells */
+void fluid_divergence_scaled(const fluid_t *f, double scale, double *div);
+void fluid_update_diagnostics(fluid_t *f, const double *stats);
 /* step.c */
-void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure);
+void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats);
 
 #endif

@@ -22,108 +22,140 @@
 const double fluid_rk_gamma[3] = {8.0 / 15.0, 5.0 / 12.0, 3.0 / 4.0};
 const double fluid_rk_zeta[3] = {0.0, -17.0 / 60.0, -5.0 / 12.0};
 
-/* Gradient of a cell-centred field at the unknowns of component c. */
-static inline double grad_c(const grid_t *g, int c, const double *p, long m, int i)
+/* Stride and inverse spacing of the gradient of a cell-centred field at the
+ * unknowns of component c (x: per i). */
+static inline long grad_stride(const grid_t *g, int c) { return c == 0 ? g->sx : c == 1 ? g->sy : 1; }
+static inline double grad_rdx(const grid_t *g, int c, int i)
 {
-    switch (c) {
-    case 0: return (p[m + g->sx] - p[m]) / g->dxc[i];
-    case 1: return (p[m + g->sy] - p[m]) / g->dy;
-    default: return (p[m + 1] - p[m]) / g->dz;
+    return c == 0 ? 1.0 / g->dxc[i] : c == 1 ? 1.0 / g->dy : 1.0 / g->dz;
+}
+
+/* u^k = u* − α Δt G φ on the unknowns of every component.  The sweep runs
+ * plane by plane and line by line with the components inside (as the
+ * right-hand side sweep of advection.c), so that each line of φ is read from
+ * memory once for the three components.  With `stats`, also accumulate
+ * Σ V u² (stats[0]) and max |u| (stats[1]) of the projected field for the
+ * diagnostics.  With `fuse_p` the pressure update p += φ (explicit viscous
+ * terms) is done on the lines of u, whose unknowns are the pressure cells
+ * except the plane beyond an x wall (left to the caller). */
+static void correct_velocity(fluid_t *f, const double *restrict ph, double dt_stage, int fuse_p, double *stats)
+{
+    const grid_t *g = f->g;
+    int nc = fluid_ncomp(g), is3d = g->dim == 3;
+    int iend[3], nj[3], nk[3];
+    long sp[3];
+    double e[3] = {0.0, 0.0, 0.0}, um = stats ? stats[1] : 0.0;
+    for (int c = 0; c < nc; c++) {
+        iend[c] = fluid_iend(g, c);
+        nj[c] = fluid_nu(g, c, 1);
+        nk[c] = fluid_nu(g, c, 2);
+        sp[c] = grad_stride(g, c);
+    }
+    double *restrict p = f->p;
+    for (int i = 0; i < g->nxl; i++) {
+        double a[3], ei[3] = {0.0, 0.0, 0.0};
+        for (int c = 0; c < nc; c++) a[c] = dt_stage * grad_rdx(g, c, i);
+        int nl = is3d ? g->n[1] : 1;
+        for (int jl = 0; jl < nl; jl++)
+            for (int c = 0; c < nc; c++) {
+                if (i >= iend[c] || (is3d && jl >= nj[c])) continue;
+                double *restrict u = f->u[c];
+                long c0 = G_IDX(g, i, jl, 0), len = is3d ? nk[c] : nj[c], s = sp[c];
+                double ac = a[c];
+                if (!stats)
+                    for (long m = c0; m < c0 + len; m++) u[m] -= ac * (ph[m + s] - ph[m]);
+                else
+                    for (long m = c0; m < c0 + len; m++) {
+                        double x = u[m] - ac * (ph[m + s] - ph[m]);
+                        u[m] = x;
+                        ei[c] += x * x;
+                        um = dmax(um, fabs(x));
+                    }
+                if (c == 0 && fuse_p)
+                    for (long m = c0; m < c0 + len; m++) p[m] += ph[m];
+            }
+        if (stats)
+            for (int c = 0; c < nc; c++) e[c] += fluid_cell_volume(f, c, i) * ei[c];
+    }
+    if (stats) {
+        stats[0] += e[0] + e[1] + e[2];
+        stats[1] = um;
     }
 }
 
-void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure)
+void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats)
 {
     const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
-    double *rhs = q->work, *phi = q->phi;
-    fluid_divergence(f, rhs);
-    double s = 1.0 / dt_stage;
-    for (long m = 0; m < g->nalloc; m++) rhs[m] *= s;
-    if (poisson_solve(q->pp, 0.0, rhs, phi) != 0)
+    /* the right-hand side D(u*)/(αΔt), then φ: solved in place */
+    double *phi = q->work;
+    fluid_divergence_scaled(f, 1.0 / dt_stage, phi);
+    if (poisson_solve(q->pp, 0.0, phi, phi) != 0)
         warn("step %ld: the pressure solve did not converge (residual %.3e)\n", f->step, q->pp->last_residual);
     f->diag.res_poisson = q->pp->last_residual;
     f->diag.it_poisson = q->pp->last_iterations;
     fluid_fill_pressure_ghosts(f, phi);
-    for (int c = 0; c < fluid_ncomp(g); c++) {
-        double *u = f->u[c];
-        int iend = fluid_iend(g, c), nj = fluid_nu(g, c, 1), nk = fluid_nu(g, c, 2);
-        for (int i = 0; i < iend; i++)
-            for (int j = 0; j < nj; j++) {
-                long c0 = G_IDX(g, i, j, 0);
-                for (int k = 0; k < nk; k++) u[c0 + k] -= dt_stage * grad_c(g, c, phi, c0 + k, i);
-            }
-    }
+    /* u −= α Δt G φ [and p += φ with explicit viscous terms], one sweep */
+    int fuse_p = update_pressure && !f->prm.implicit_viscous;
+    correct_velocity(f, phi, dt_stage, fuse_p, stats);
     if (update_pressure) {
         if (f->prm.implicit_viscous) {
             /* p += φ − (α Δt ν/2) L φ: the pressure consistent with the
              * Crank–Nicolson predictor (Brown, Cortez & Minion 2001) */
-            poisson_apply(q->pp, 0.0, phi, rhs);
-            double a = 0.5 * dt_stage * f->prm.nu;
-            for (int i = 0; i < g->nxl; i++)
-                for (int j = 0; j < g->n[1]; j++)
-                    for (int k = 0; k < g->n[2]; k++) {
-                        long m = G_IDX(g, i, j, k);
-                        f->p[m] += phi[m] - a * rhs[m];
-                    }
+            const poisson_t *pp = q->pp;
+            double a = 0.5 * dt_stage * f->prm.nu, cy = a * pp->cy, cz = a * pp->cz;
+            long sx = g->sx, sy = g->sy;
+            double *restrict p = f->p;
+            const double *restrict ph = phi;
+            for (int i = 0; i < g->nxl; i++) {
+                int ig = i + g->ix0;
+                /* φ − a L φ with the stencil of poisson.c (φ's ghosts are filled) */
+                double cw = a * pp->cw[ig], ce = a * pp->ce[ig], cd = 1.0 + a * pp->cd[ig] + 2.0 * (cy + cz);
+                FLUID_FOR_LINES(g, i, g->n[1], g->n[2], c0, len)
+                {
+                    if (g->dim == 3)
+                        for (long m = c0; m < c0 + len; m++)
+                            p[m] += cd * ph[m] - cw * ph[m - sx] - ce * ph[m + sx] - cy * (ph[m + sy] + ph[m - sy]) -
+                                    cz * (ph[m + 1] + ph[m - 1]);
+                    else
+                        for (long m = c0; m < c0 + len; m++)
+                            p[m] += cd * ph[m] - cw * ph[m - sx] - ce * ph[m + sx] - cy * (ph[m + sy] + ph[m - sy]);
+                }
+            }
         } else {
-            for (int i = 0; i < g->nxl; i++)
-                for (int j = 0; j < g->n[1]; j++)
-                    for (int k = 0; k < g->n[2]; k++) {
-                        long m = G_IDX(g, i, j, k);
-                        f->p[m] += phi[m];
-                    }
+            /* p += φ on the planes the sweep of u above did not cover */
+            for (int i = fluid_iend(g, 0); i < g->nxl; i++)
+                FLUID_FOR_LINES(g, i, g->n[1], g->n[2], c0, len)
+                for (long m = c0; m < c0 + len; m++) f->p[m] += phi[m];
         }
         fluid_fill_pressure_ghosts(f, f->p);
     }
     fluid_apply_bc(f);
 }
 
-void fluid_stage_project(fluid_t *f, double dt_stage) { fluid_project_stage(f, dt_stage, 1); }
+void fluid_stage_project(fluid_t *f, double dt_stage) { fluid_project_stage(f, dt_stage, 1, NULL); }
 
 void fluid_project(fluid_t *f)
 {
     fluid_apply_bc(f);
-    fluid_project_stage(f, 1.0, 0);
+    fluid_project_stage(f, 1.0, 0, NULL);
 }
 
-/* Predictor of one stage for component c (u^{k−1} → u*). */
-static void predict_component(fluid_t *f, int c, int stage, double dt)
+/* Crank–Nicolson: u[c] holds the explicit part rhs = u* of the predictor;
+ * solve (I − αΔtν/2 L) u* = rhs  ⇔  (L_hom − λ) u* = −λ rhs − wall terms. */
+static void helmholtz_component(fluid_t *f, int c, double adt)
 {
     const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
-    double gam = fluid_rk_gamma[stage], zet = fluid_rk_zeta[stage], a = gam + zet, adt = a * dt;
-    double *u = f->u[c], *h = q->dudt[c], *ho = q->dudt_old[c], *w = q->work;
-    double fc = f->prm.body_force[c];
-    int impl = f->prm.implicit_viscous;
+    double *restrict u = f->u[c], *restrict w = q->work;
     int iend = fluid_iend(g, c), nj = fluid_nu(g, c, 1), nk = fluid_nu(g, c, 2);
-    if (impl) {
-        /* w = (αΔtν/2) L u^{k−1}, the explicit half of Crank–Nicolson */
-        field_zero(g, w);
-        fluid_laplacian_add(f, c, u, 0.5 * adt * f->prm.nu, w);
-    }
+    double lam = 2.0 / (adt * f->prm.nu);
     for (int i = 0; i < iend; i++)
-        for (int j = 0; j < nj; j++) {
-            long c0 = G_IDX(g, i, j, 0);
-            for (int k = 0; k < nk; k++) {
-                long m = c0 + k;
-                double du = dt * (gam * h[m] + zet * ho[m]) + adt * (fc - grad_c(g, c, f->p, m, i));
-                u[m] += du + (impl ? w[m] : 0.0);
-            }
-        }
-    if (impl) {
-        /* (I − αΔtν/2 L) u* = rhs  ⇔  (L_hom − λ) u* = −λ rhs − wall terms */
-        double lam = 2.0 / (adt * f->prm.nu);
-        for (int i = 0; i < iend; i++)
-            for (int j = 0; j < nj; j++)
-                for (int k = 0; k < nk; k++) {
-                    long m = G_IDX(g, i, j, k);
-                    w[m] = -lam * u[m];
-                }
-        fluid_wall_terms_add(f, c, -1.0, w);
-        if (poisson_solve(q->pv[c], lam, w, u) != 0)
-            warn("step %ld: the Helmholtz solve of component %c did not converge\n", f->step, "uvw"[c]);
-    }
+        FLUID_FOR_LINES(g, i, nj, nk, c0, len)
+        for (long m = c0; m < c0 + len; m++) w[m] = -lam * u[m];
+    fluid_wall_terms_add(f, c, -1.0, w);
+    if (poisson_solve(q->pv[c], lam, w, u) != 0)
+        warn("step %ld: the Helmholtz solve of component %c did not converge\n", f->step, "uvw"[c]);
 }
 
 void fluid_step(fluid_t *f, double dt)
@@ -131,29 +163,37 @@ void fluid_step(fluid_t *f, double dt)
     const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
     int nc = fluid_ncomp(g);
+    double stats[2] = {0.0, 0.0};
     for (int s = 0; s < 3; s++) {
         double adt = (fluid_rk_gamma[s] + fluid_rk_zeta[s]) * dt;
-        /* H^k from u^{k−1} (its ghosts are valid: every stage ends with them) */
-        for (int c = 0; c < nc; c++) field_zero(g, q->dudt[c]);
-        fluid_advection_add(f, -1.0, q->dudt);
-        if (!f->prm.implicit_viscous)
-            for (int c = 0; c < nc; c++) fluid_laplacian_add(f, c, f->u[c], f->prm.nu, q->dudt[c]);
-        for (int c = 0; c < nc; c++) predict_component(f, c, s, dt);
+        /* H^k = −∇·(u⊗u) [+ νLu] from u^{k−1} (its ghosts are valid: every
+         * stage ends with them) into spare, and the predictor
+         * u* = u^{k−1} + Δt(γH^k + ζH^{k−1}) + αΔt(f − G p) [+ αΔtν/2 L u^{k−1}]
+         * over h (which held H^{k−1}), in one sweep; then rotate:
+         * u ← u*, h ← H^k, spare ← u^{k−1} (free).  The last stage's H is
+         * not needed (ζ_1 = 0: the first stage of the next step does not
+         * read H_old), so it is not stored. */
+        int impl = f->prm.implicit_viscous;
+        fluid_rhs_predict(f, -1.0, impl ? 0.0 : f->prm.nu, dt * fluid_rk_gamma[s], dt * fluid_rk_zeta[s], adt,
+                          impl ? 0.5 * adt * f->prm.nu : 0.0, s < 2 ? q->spare : NULL, q->h);
         for (int c = 0; c < nc; c++) {
-            double *t = q->dudt[c];
-            q->dudt[c] = q->dudt_old[c];
-            q->dudt_old[c] = t;
+            double *old = f->u[c];
+            f->u[c] = q->h[c];
+            q->h[c] = q->spare[c];
+            q->spare[c] = old;
         }
+        if (impl)
+            for (int c = 0; c < nc; c++) helmholtz_component(f, c, adt);
         fluid_apply_bc(f);
         if (f->stage_hook) {
             f->stage_hook(f, s, adt, f->hook_ctx);
             fluid_apply_bc(f);
         }
-        fluid_project_stage(f, adt, 1);
+        fluid_project_stage(f, adt, 1, s == 2 ? stats : NULL);
         if (f->stage_end_hook) f->stage_end_hook(f, s, adt, f->hook_ctx);
     }
     f->time += dt;
     f->step++;
     f->diag.dt = dt;
-    fluid_update_diagnostics(f);
+    fluid_update_diagnostics(f, stats);
 }

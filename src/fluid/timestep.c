@@ -25,9 +25,9 @@ double fluid_convective_rate(const fluid_t *f)
         for (int j = 0; j < g->n[1]; j++)
             for (int k = 0; k < g->n[2]; k++) {
                 long m = G_IDX(g, i, j, k);
-                double s = fmax(fabs(u[m]), fabs(u[m - g->sx])) * rdx + fmax(fabs(v[m]), fabs(v[m - g->sy])) * rdy;
-                if (w) s += fmax(fabs(w[m]), fabs(w[m - 1])) * rdz;
-                r = fmax(r, s);
+                double s = dmax(fabs(u[m]), fabs(u[m - g->sx])) * rdx + dmax(fabs(v[m]), fabs(v[m - g->sy])) * rdy;
+                if (w) s += dmax(fabs(w[m]), fabs(w[m - 1])) * rdz;
+                r = dmax(r, s);
             }
     }
     return grid_max(g, r);

@@ -16,6 +16,9 @@ static const cfg_key_t poisson_keys[] = {
     {"poisson", "mg_max_cycles", CFG_INT, "100", 1, 10000, NULL, "multigrid: maximum number of V-cycles"},
     {"poisson", "mg_pre", CFG_INT, "2", 0, 20, NULL, "multigrid: pre-smoothing sweeps"},
     {"poisson", "mg_post", CFG_INT, "2", 0, 20, NULL, "multigrid: post-smoothing sweeps"},
+    {"poisson", "fftw_planner", CFG_ENUM, "estimate", 1, 0, "estimate|measure",
+     "fft: FFTW planner; measure times candidate algorithms at start-up and is faster, but may pick "
+     "different ones from run to run, so results are then not bit-identical between runs (or a restart)"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL}};
 
 void poisson_register_keys(void) { cfg_schema_add(poisson_keys); }
@@ -27,6 +30,7 @@ void poisson_opts_from_config(cfg_t *cfg, poisson_opts_t *o)
     o->mg_max_cycles = cfg_int(cfg, "poisson", "mg_max_cycles");
     o->mg_pre = cfg_int(cfg, "poisson", "mg_pre");
     o->mg_post = cfg_int(cfg, "poisson", "mg_post");
+    o->fftw_measure = cfg_enum(cfg, "poisson", "fftw_planner") == 1;
 }
 
 /* Homogeneous BC of face (d, s) for location loc. */
@@ -212,7 +216,7 @@ void poisson_apply(poisson_t *p, double lambda, double *x, double *y)
 
 /* Volume weight of unknown i (global) for the compatibility condition of a
  * singular problem: Σ w_i (L x)_i = 0 for every x. */
-static double x_weight(const poisson_t *p, int ig)
+double poisson_x_weight(const poisson_t *p, int ig)
 {
     const grid_t *g = p->g;
     if (p->loc == VAR_U) return g->geom == GEOM_AXI ? g->gxf[ig] * g->gdxc[ig] : g->gdxc[ig];
@@ -220,14 +224,14 @@ static double x_weight(const poisson_t *p, int ig)
 }
 
 /* Weighted mean of the unknowns of f. */
-static double weighted_mean(const poisson_t *p, const double *f)
+double poisson_weighted_mean(const poisson_t *p, const double *f)
 {
     const grid_t *g = p->g;
     double s = 0.0, w = 0.0;
     for (int i = 0; i < g->nxl; i++) {
         int ig = i + g->ix0;
         if (ig >= p->nu[0]) continue;
-        double wi = x_weight(p, ig), si = 0.0;
+        double wi = poisson_x_weight(p, ig), si = 0.0;
         for (int j = 0; j < p->nu[1]; j++)
             for (int k = 0; k < p->nu[2]; k++) si += f[G_IDX(g, i, j, k)];
         s += wi * si;
@@ -238,7 +242,7 @@ static double weighted_mean(const poisson_t *p, const double *f)
     return r[0] / r[1];
 }
 
-static void add_constant(const poisson_t *p, double *f, double c)
+void poisson_add_constant(const poisson_t *p, double *f, double c)
 {
     const grid_t *g = p->g;
     for (int i = 0; i < g->nxl; i++) {
@@ -253,17 +257,17 @@ int poisson_solve(poisson_t *p, double lambda, const double *b, double *x)
     if (!p->backend) die("poisson_solve: operator created without a solver (poisson_create_operator)");
     const double *rhs = b;
     double *tmp = NULL;
-    int sing = p->singular && lambda == 0.0;
+    int sing = p->singular && lambda == 0.0 && !p->backend_handles_singular;
     if (sing) {
         /* Remove the incompatible part (weighted mean) of b. */
-        double m = weighted_mean(p, b);
+        double m = poisson_weighted_mean(p, b);
         tmp = field_alloc(p->g);
         field_copy(p->g, tmp, b);
-        add_constant(p, tmp, -m);
+        poisson_add_constant(p, tmp, -m);
         rhs = tmp;
     }
     int rc = p->backend->solve(p, p->impl, lambda, rhs, x);
-    if (sing) add_constant(p, x, -weighted_mean(p, x));
+    if (sing) poisson_add_constant(p, x, -poisson_weighted_mean(p, x));
     free(tmp);
     return rc;
 }
@@ -274,7 +278,7 @@ double poisson_residual(poisson_t *p, double lambda, const double *b, double *x)
     double *y = field_alloc(g);
     double *bb = field_alloc(g);
     field_copy(g, bb, b);
-    if (p->singular && lambda == 0.0) add_constant(p, bb, -weighted_mean(p, b));
+    if (p->singular && lambda == 0.0) poisson_add_constant(p, bb, -poisson_weighted_mean(p, b));
     poisson_apply(p, lambda, x, y);
     double rr = 0.0, bn = 0.0;
     for (int i = 0; i < g->nxl; i++)

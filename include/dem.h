@@ -1,0 +1,160 @@
+/* dem.h — soft-sphere discrete element method (DEM): spheres with individual
+ * radius and density, contact laws chosen in the case file, planar walls,
+ * fixed particles, periodic directions, linked cells + Verlet lists, velocity
+ * Verlet integration, packing preparation, output and diagnostics.
+ *
+ * Usable alone (a scene with [particles] and no [fluid] runs DEM only, see
+ * dem_run_case) or sub-cycled inside a fluid step (dem_advance), with the
+ * hydrodynamic force and torque of each particle given through
+ * dem_ext_force()/dem_ext_torque() (held constant while sub-cycling).
+ *
+ * Particle order: particles are reordered by cell from time to time (at
+ * neighbour-list rebuilds) to keep neighbours close in memory.  Any index
+ * into the arrays below is valid only until the next dem_step/dem_advance;
+ * dem_id() gives each particle's permanent identity (0..N-1 in the order of
+ * creation).  The external force/torque arrays travel with the particles.
+ *
+ * Parallelism: replicated data.  Every rank holds every particle and
+ * integrates all of them identically; the pair and wall forces are split
+ * among the ranks by particle ranges and summed (MPI_Allreduce).  Same input
+ * and same rank count give bit-identical results.
+ */
+#ifndef IBMDEM_DEM_H
+#define IBMDEM_DEM_H
+
+#include <hdf5.h>
+#include <mpi.h>
+
+#include "config.h"
+
+typedef struct dem dem_t;
+
+/* Status returned by dem_step/dem_advance.  On an error the state is that of
+ * the end of the failing step; dem_error() gives the message. */
+typedef enum {
+    DEM_OK = 0,
+    DEM_ERR_OVERLAP,    /* an overlap exceeded dem.max_overlap × the smaller diameter */
+    DEM_ERR_LEFT_DOMAIN,/* a particle centre left the domain through a non-periodic face */
+    DEM_ERR_NAN,        /* a non-finite position or velocity */
+    DEM_ERR_TIMESTEP    /* dem.dt above t_c/20 for the contact time of the particles present */
+} dem_status_t;
+
+typedef struct {
+    double time;
+    long step;
+    long n_particles, n_mobile;
+    double ke_trans, ke_rot;   /* Σ ½ m v², Σ ½ I ω² of the mobile particles (J) */
+    double e_elastic;          /* energy stored in the contact springs (J) */
+    long n_contacts;           /* particle–particle contacts (overlapping pairs) */
+    long n_wall_contacts;
+    double max_overlap;        /* max δ / (2 min(R_i, R_j)) over contacts of the last step */
+    double momentum[3];        /* Σ m v of the mobile particles */
+    double com[3];             /* centre of mass of the mobile particles */
+    long rebuilds;             /* neighbour-list rebuilds so far */
+    long contacts_started;     /* contacts (pairs and walls) started since the creation */
+} dem_diag_t;
+
+/* Case-file schema of [particles], [contact], [walls], [bed], [packing], [dem]. */
+void dem_register_keys(void);
+
+/* Build the DEM of a case file: domain ([domain] length/origin, periodic faces
+ * from [boundary]), contact law, walls, particles (inserted, read from a
+ * packing/checkpoint file or a LAMMPS data file), rough bed.  Does not run the
+ * packing preparation (dem_prepare_packing does).  Stops with file:line:
+ * section.key: reason on bad input. */
+dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm);
+void dem_free(dem_t *d);
+
+/* Add a particle (before the first step, or between steps: the neighbour
+ * lists are rebuilt).  fixed != 0: infinite mass, never moves (rough beds). */
+int dem_add_particle(dem_t *d, const double x[3], const double v[3], double radius, double density, int fixed);
+/* Set the angular velocity of the particle with the given id. */
+void dem_set_omega(dem_t *d, long id, const double w[3]);
+
+/* One time step of size dem_dt(). */
+dem_status_t dem_step(dem_t *d);
+/* Advance to t_target with equal steps no longer than dem_dt() (sub-cycling
+ * inside a fluid step).  External forces are held constant. */
+dem_status_t dem_advance(dem_t *d, double t_target);
+/* nsteps steps of size dem_dt(). */
+dem_status_t dem_run_steps(dem_t *d, long nsteps);
+const char *dem_error(const dem_t *d);
+
+double dem_dt(const dem_t *d);
+double dem_time(const dem_t *d);
+double dem_contact_time(const dem_t *d);
+void dem_set_time(dem_t *d, double t);
+void dem_set_gravity(dem_t *d, const double g[3]);
+
+/* Particle arrays (3-vectors are stored x,y,z per particle). */
+int dem_count(const dem_t *d);
+const double *dem_positions(const dem_t *d);
+const double *dem_velocities(const dem_t *d);
+const double *dem_omegas(const dem_t *d);
+const double *dem_radii(const dem_t *d);
+const long *dem_ids(const dem_t *d);
+const unsigned char *dem_fixed(const dem_t *d);
+double dem_mass(const dem_t *d, int i); /* 0 for a fixed particle's inverse → returns +inf */
+/* Writable per-particle inputs, added to the contact forces and gravity at
+ * every step (zeroed at creation). */
+double *dem_ext_force(dem_t *d);
+double *dem_ext_torque(dem_t *d);
+/* Total contact force of each particle (pairs and walls) at the last step. */
+const double *dem_contact_forces(const dem_t *d);
+
+/* Bytes allocated by the DEM per particle (particles, lists, cells, walls). */
+double dem_memory_per_particle(const dem_t *d);
+
+/* Time spent in the parts of a step (rank 0 prints). */
+void dem_print_timers(const dem_t *d);
+
+/* Walls */
+int dem_wall_count(const dem_t *d);
+/* Force exerted BY the particles ON wall w at the last step (N). */
+void dem_wall_force(const dem_t *d, int w, double f[3]);
+int dem_wall_active(const dem_t *d, int w);
+const char *dem_wall_name(const dem_t *d, int w);
+
+/* Diagnostics (collective).  dem_diag_light skips the elastic energy (a pass
+ * over the contacts). */
+void dem_diag(dem_t *d, dem_diag_t *out);
+void dem_diag_light(dem_t *d, dem_diag_t *out);
+
+/* Packing preparation as configured in [packing]: settle under gravity until
+ * the kinetic energy per particle drops below the rest criterion (dense:
+ * frictionless settling; loose: high friction), then restore the contact
+ * parameters and reset time to 0.  Returns 0 at rest, 1 if the time limit was
+ * reached (a warning is printed), or a dem_status_t error + 10. */
+int dem_prepare_packing(dem_t *d, cfg_t *cfg, const char *outdir);
+
+/* Output */
+/* HDF5 snapshot <dir>/particles_<index>.h5 and its entry in
+ * <dir>/particles.xdmf (the XDMF file is rewritten, so it is always valid). */
+void dem_write_snapshot(dem_t *d, const char *dir, int index);
+/* Full state (particles, contact and wall histories, time) to HDF5; a packing
+ * file is a checkpoint.  dem_read_checkpoint replaces the particles. */
+void dem_write_checkpoint(dem_t *d, const char *path);
+void dem_read_checkpoint(dem_t *d, const char *path);
+/* The same into / from an open HDF5 file or group (a part of a run checkpoint). */
+void dem_checkpoint_write_loc(dem_t *d, hid_t loc);
+void dem_checkpoint_read_loc(dem_t *d, hid_t loc, const char *path);
+/* After a restart: list the snapshots 0..first-1 already in dir in the XDMF index. */
+void dem_snapshots_resume(dem_t *d, const char *dir, int first);
+/* Number of snapshots written (or listed) so far. */
+int dem_snapshot_count(const dem_t *d);
+/* LAMMPS/LIGGGHTS data file (atom_style sphere: id type diameter density x y z). */
+void dem_write_lammps_data(dem_t *d, const char *path);
+
+/* Rate of change of the grains for time.steady_tol: rms velocity / mean
+ * diameter of the mobile particles (1/s), INFINITY before time `after`. */
+double dem_rest_rate(dem_t *d, double after);
+
+/* Run a DEM-only case without the run driver (ibmdem run does the same
+ * through src/core/sim_dem.c): preparation (if [packing] prepare), then the
+ * run to time.t_end (or until the grains' rate of change dem_rest_rate falls
+ * below time.steady_tol) with snapshots every output.fields_every, the time
+ * series dem_series.csv and the checks; writes its outputs in outdir.  Returns 0 on success, non-zero after a diagnostic stopped the run
+ * (a checkpoint was written). */
+int dem_run_case(cfg_t *cfg, const char *outdir);
+
+#endif

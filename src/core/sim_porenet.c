@@ -1,0 +1,258 @@
+/* sim_porenet.c — the pore-network fluid (porenet.h) as a part of a run.
+ *
+ * The fluid model is chosen in the case file: a scene with a [porenet]
+ * section has the pore network and no resolved fluid.  Without DEM particles
+ * the skeleton is a fixed packing read from porenet.packing (a permeameter):
+ * the network is built and solved once, and the run reports the pore
+ * pressures, the fluxes, the forces and the permeability.  With DEM particles
+ * ([particles]) the part is coupled with the DEM (thesis fig. 4.3): the DEM
+ * part advances first by one step of its own, then this part computes the
+ * pore volume rates from the motion, the pressures and the fluid forces,
+ * which act on the particles during the next step (pn_model_couple_dem).
+ * The step is the smaller of the DEM step and the viscous limit of the
+ * coupled problem (pn_coupled_dt).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "config.h"
+#include "dem.h"
+#include "porenet.h"
+#include "sim.h"
+#include "util.h"
+
+typedef struct {
+    sim_t *sim;
+    pn_model_t m;
+    int with_dem;
+    dem_t *d;           /* the DEM engine (with particles), once started */
+    double g[3];        /* gravity (buoyancy) */
+    int started;
+    int n;
+    double *x, *r;      /* the spheres as the model sees them (the packing, or the DEM's in id order) */
+    double *xp, *rp;    /* the fixed packing read from porenet.packing */
+    double q[6];
+    double kappa[3];
+} porenet_part_t;
+
+static const char *const pn_cols[] = {"porenet_q_in_max", "porenet_q_out_max", "porenet_p_max", "porenet_pores"};
+
+static void read_packing(cfg_t *cfg, porenet_part_t *pp)
+{
+    const char *path = cfg_string(cfg, "porenet", "packing");
+    FILE *f = fopen(path, "r");
+    if (!f) cfg_fail(cfg, "porenet", "packing", "cannot open %s", path);
+    char line[1024];
+    int cap = 1024, n = 0, ln = 0;
+    pp->xp = malloc(3 * (size_t)cap * sizeof *pp->xp);
+    pp->rp = malloc((size_t)cap * sizeof *pp->rp);
+    while (fgets(line, sizeof line, f)) {
+        ln++;
+        char *s = line;
+        while (*s == ' ' || *s == '\t') s++;
+        if (*s == '#' || *s == '\n' || *s == 0) continue;
+        if (n == cap) {
+            cap *= 2;
+            pp->xp = realloc(pp->xp, 3 * (size_t)cap * sizeof *pp->xp);
+            pp->rp = realloc(pp->rp, (size_t)cap * sizeof *pp->rp);
+        }
+        if (sscanf(s, "%lf %lf %lf %lf", pp->xp + 3 * n, pp->xp + 3 * n + 1, pp->xp + 3 * n + 2, pp->rp + n) != 4 ||
+            !(pp->rp[n] > 0))
+            cfg_fail(cfg, "porenet", "packing", "%s:%d: expected x y z r with r > 0", path, ln);
+        n++;
+    }
+    fclose(f);
+    if (n < 4) cfg_fail(cfg, "porenet", "packing", "%s: %d spheres (at least 4 needed)", path, n);
+    pp->n = n;
+    /* periodic axes: bring the centres into the box */
+    for (int i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++)
+            if (pp->m.dom.periodic[a]) {
+                double L = pp->m.dom.hi[a] - pp->m.dom.lo[a];
+                double v = fmod(pp->xp[3 * i + a] - pp->m.dom.lo[a], L);
+                if (v < 0) v += L;
+                pp->xp[3 * i + a] = pp->m.dom.lo[a] + v;
+            }
+    pp->x = pp->xp;
+    pp->r = pp->rp;
+}
+
+static void after_solve(porenet_part_t *pp)
+{
+    pn_face_fluxes(&pp->m.dom, &pp->m.net, pp->m.p, pp->q);
+    for (int a = 0; a < 3; a++) pp->kappa[a] = pn_model_permeability(&pp->m, a);
+}
+
+/* dt <= 0: the initial state (rigid skeleton) */
+static void solve_now(porenet_part_t *pp, double dt)
+{
+    if (pp->with_dem) {
+        if (pn_model_couple_dem(&pp->m, pp->d, pp->g, dt)) die("porenet: %s", pp->m.err);
+        pp->n = pp->m.n;
+        pp->x = pp->m.xid;
+        pp->r = pp->m.rid;
+    } else if (pn_model_step(&pp->m, pp->n, pp->x, pp->r, 0.0))
+        die("porenet: %s", pp->m.err);
+    after_solve(pp);
+}
+
+/* The first solve, once the particles exist (the DEM prepares its packing
+ * lazily, at the first step of a new run). */
+static void ensure_started(porenet_part_t *pp)
+{
+    if (pp->started) return;
+    pp->started = 1;
+    if (pp->with_dem) pp->d = sim_dem_engine(pp->sim);
+    solve_now(pp, 0.0);
+    double re, sr, por;
+    char wbuf[1024];
+    if (pn_model_validity(&pp->m, pp->r, wbuf, sizeof wbuf, &re, &sr, &por)) warn("porenet: outside the model's validity:\n%s", wbuf);
+    msg("porenet: %d spheres, %d pores (%.2f per sphere), %d throats; triangulation %.3g s, network %.3g s, "
+        "factorisation %.3g s\n",
+        pp->n, pp->m.net.npore, (double)pp->m.net.npore / pp->n, pp->m.net.nthroat, pp->m.t_tri, pp->m.t_net,
+        pp->m.t_factor);
+    if (pp->with_dem)
+        msg("porenet: coupled with the DEM, viscous step limit %.4g s (DEM step %.4g s)\n", pn_coupled_dt(&pp->m, pp->d),
+            dem_dt(pp->d));
+    for (int a = 0; a < 3; a++)
+        if (isfinite(pp->kappa[a])) msg("porenet: permeability along %c = %.6e m^2\n", 'x' + a, pp->kappa[a]);
+}
+
+static double part_stable_dt(void *ctx)
+{
+    porenet_part_t *pp = ctx;
+    ensure_started(pp);
+    if (!pp->with_dem) return INFINITY; /* a rigid skeleton sets no limit */
+    /* one DEM step per coupled step, within the viscous limit (thesis 4.21) */
+    return fmin(pn_coupled_dt(&pp->m, pp->d), dem_dt(pp->d));
+}
+
+static void part_advance(void *ctx, double dt)
+{
+    porenet_part_t *pp = ctx;
+    ensure_started(pp);
+    /* fixed packing: the same steady solution (boundary values may change on restart) */
+    solve_now(pp, pp->with_dem ? dt : 0.0);
+}
+
+static void part_diagnostics(void *ctx, double *c)
+{
+    porenet_part_t *pp = ctx;
+    double qin = 0, qout = 0, pmax = 0;
+    for (int f = 0; f < 6; f++) {
+        qin = fmax(qin, pp->q[f]);
+        qout = fmax(qout, -pp->q[f]);
+    }
+    for (int i = 0; i < pp->m.net.npore; i++) pmax = fmax(pmax, fabs(pp->m.p[i]));
+    c[0] = qin;
+    c[1] = qout;
+    c[2] = pmax;
+    c[3] = pp->m.net.npore;
+}
+
+static int part_diverged(void *ctx, char *why, size_t n)
+{
+    porenet_part_t *pp = ctx;
+    for (int i = 0; i < pp->m.net.npore; i++)
+        if (!isfinite(pp->m.p[i])) {
+            snprintf(why, n, "non-finite pore pressure");
+            return 1;
+        }
+    return 0;
+}
+
+static void part_write_fields(void *ctx, double time, long step)
+{
+    (void)step;
+    porenet_part_t *pp = ctx;
+    ensure_started(pp);
+    pn_write_snapshot(&pp->m, pp->x, pp->sim->out.dir, time);
+}
+
+static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
+{
+    porenet_part_t *pp = ctx;
+    ensure_started(pp);
+    pn_model_t *m = &pp->m;
+    char key[160];
+    static const char *fn[6] = {"x_lo", "x_hi", "y_lo", "y_hi", "z_lo", "z_hi"};
+#define KEY(...) (snprintf(key, sizeof key, __VA_ARGS__), key)
+    io_summary_long(y, KEY("%s.spheres", prefix), pp->n);
+    io_summary_long(y, KEY("%s.pores", prefix), m->net.npore);
+    io_summary_long(y, KEY("%s.throats", prefix), m->net.nthroat);
+    io_summary_long(y, KEY("%s.triangulations", prefix), m->n_retri);
+    io_summary_long(y, KEY("%s.coupled_steps", prefix), m->n_steps);
+    for (int a = 0; a < 3; a++)
+        if (isfinite(pp->kappa[a])) io_summary_double(y, KEY("%s.permeability_%c", prefix, 'x' + a), pp->kappa[a]);
+    for (int f = 0; f < 6; f++)
+        if (!m->dom.periodic[f / 2]) io_summary_double(y, KEY("%s.flux_in.%s", prefix, fn[f]), pp->q[f]);
+    double F[6][3], fs[3] = {0, 0, 0};
+    pn_face_forces(&m->dom, &m->net, m->p, F);
+    for (int i = 0; i < pp->n; i++)
+        for (int a = 0; a < 3; a++) fs[a] += m->f[3 * i + a];
+    for (int a = 0; a < 3; a++) io_summary_double(y, KEY("%s.force_on_spheres_%c", prefix, 'x' + a), fs[a]);
+    for (int f = 0; f < 6; f++)
+        if (!m->dom.periodic[f / 2])
+            for (int a = 0; a < 3; a++) io_summary_double(y, KEY("%s.force_on_face.%s_%c", prefix, fn[f], 'x' + a), F[f][a]);
+    double re, sr, por;
+    char wbuf[1024];
+    int nw = pn_model_validity(m, pp->r, wbuf, sizeof wbuf, &re, &sr, &por);
+    io_summary_double(y, KEY("%s.pore_reynolds", prefix), re);
+    io_summary_double(y, KEY("%s.size_ratio_min", prefix), sr);
+    io_summary_double(y, KEY("%s.porosity", prefix), por);
+    io_summary_long(y, KEY("%s.validity_warnings", prefix), nw);
+    io_summary_double(y, KEY("%s.void_partition", prefix), m->net.void_sum / (m->net.box_volume - m->net.solid_volume));
+    io_summary_double(y, KEY("%s.time_triangulation", prefix), m->t_tri);
+    io_summary_double(y, KEY("%s.time_network", prefix), m->t_net);
+    io_summary_double(y, KEY("%s.time_factorisation", prefix), m->t_factor);
+    io_summary_double(y, KEY("%s.time_solves", prefix), m->t_solve);
+    io_summary_double(y, KEY("%s.time_forces", prefix), m->t_force);
+    io_summary_double(y, KEY("%s.time_volume_rates", prefix), m->t_vol);
+#undef KEY
+}
+
+static void part_destroy(void *ctx)
+{
+    porenet_part_t *pp = ctx;
+    pn_model_free(&pp->m);
+    free(pp->xp);
+    free(pp->rp);
+    free(pp);
+}
+
+void sim_add_porenet(sim_t *s, cfg_t *cfg)
+{
+    porenet_part_t *pp = xcalloc(1, sizeof *pp);
+    pp->sim = s;
+    pn_model_from_config(cfg, &pp->m);
+    pp->with_dem = cfg_has_section(cfg, "particles");
+    if (pp->with_dem) {
+        if (cfg_has(cfg, "porenet", "packing"))
+            cfg_fail(cfg, "porenet", "packing", "the scene has DEM particles ([particles]): give one or the other");
+        cfg_vec3(cfg, "dem", "gravity", pp->g);
+        /* the DEM's faces ([boundary]) and the network's must agree on periodicity */
+        static const char *fn[6] = {"x_lo", "x_hi", "y_lo", "y_hi", "z_lo", "z_hi"};
+        for (int f = 0; f < 6; f++)
+            if ((cfg_enum(cfg, "boundary", fn[f]) == 0) != pp->m.dom.periodic[f / 2])
+                cfg_fail(cfg, "porenet", fn[f], "must be periodic exactly when boundary.%s is (the DEM's face)", fn[f]);
+    } else {
+        read_packing(cfg, pp);
+        ensure_started(pp);
+    }
+    sim_part_t part = {
+        .name = "porenet",
+        .ctx = pp,
+        .stable_dt = part_stable_dt,
+        .advance = part_advance,
+        .ncol = 4,
+        .col_names = pn_cols,
+        .diagnostics = part_diagnostics,
+        .diverged = part_diverged,
+        .write_fields = part_write_fields,
+        .summary = part_summary,
+        .destroy = part_destroy,
+    };
+    sim_add_part(s, &part);
+}

@@ -1,0 +1,549 @@
+/* dem_config.c — case-file keys of the DEM and the construction of a scene
+ * from them: domain, contact law, walls, particles, rough bed. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dem_private.h"
+#include "util.h"
+
+#define BIG 1e300
+
+#define USER_WALL_KEYS(N)                                                                                         \
+    {"walls", "wall" #N "_point", CFG_VEC3, NULL, -BIG, BIG, NULL, "a point of extra wall " #N " (m)"},          \
+        {"walls", "wall" #N "_normal", CFG_VEC3, NULL, -BIG, BIG, NULL,                                           \
+         "normal of extra wall " #N ", pointing to the particles' side"},                                         \
+        {"walls", "wall" #N "_velocity", CFG_VEC3, "0 0 0", -BIG, BIG, NULL, "velocity of extra wall " #N " (m/s)"}, \
+        {"walls", "wall" #N "_remove_time", CFG_DOUBLE, "-1", -1, BIG, NULL,                                      \
+         "time at which extra wall " #N " is removed (s; -1: never), e.g. the gate of a column collapse"}
+
+static const cfg_key_t dem_keys[] = {
+    /* [particles] */
+    {"particles", "source", CFG_ENUM, "none", 1, 0, "none|insert|file|lammps_data",
+     "where the particles come from: none (added by a program), random insertion, an HDF5 packing or "
+     "checkpoint (file), a LAMMPS data file (lammps_data)"},
+    {"particles", "file", CFG_STRING, NULL, 1, 0, NULL, "HDF5 packing/checkpoint or LAMMPS data file to read"},
+    {"particles", "count", CFG_INT, "0", 0, 2e9, NULL, "insert: number of particles (or give volume_fraction)"},
+    {"particles", "volume_fraction", CFG_DOUBLE, "0", 0, 0.45, NULL,
+     "insert: solid volume fraction of the insertion region (random sequential insertion jams near 0.38)"},
+    {"particles", "radius", CFG_DOUBLE, NULL, 1e-12, BIG, NULL, "insert: mean radius (m)"},
+    {"particles", "polydispersity", CFG_DOUBLE, "0", 0, 0.9, NULL,
+     "insert: radii uniform in [R(1-p), R(1+p)] with R = radius"},
+    {"particles", "density", CFG_DOUBLE, "2500", 1e-12, BIG, NULL, "particle density (kg/m^3)"},
+    {"particles", "region_lo", CFG_VEC3, NULL, -BIG, BIG, NULL, "insert: low corner of the region (default: domain)"},
+    {"particles", "region_hi", CFG_VEC3, NULL, -BIG, BIG, NULL, "insert: high corner of the region (default: domain)"},
+    {"particles", "seed", CFG_INT, "1", 0, 2147483647, NULL, "insert: random seed"},
+    {"particles", "velocity", CFG_VEC3, "0 0 0", -BIG, BIG, NULL, "insert: initial velocity (m/s)"},
+    {"particles", "velocity_spread", CFG_DOUBLE, "0", 0, BIG, NULL,
+     "insert: each velocity component gets a uniform random part in [-s, s] (m/s)"},
+    /* [contact] */
+    {"contact", "law", CFG_ENUM, "linear", 1, 0, dem_contact_law_choices,
+     "contact law: linear spring-dashpot (seed) or Hertz-Mindlin"},
+    {"contact", "parameters", CFG_ENUM, "restitution", 1, 0, "restitution|stiffness",
+     "linear: constants from restitution and contact_time (per pair effective mass), or kn and gamma_n given"},
+    {"contact", "restitution", CFG_DOUBLE, NULL, 1e-6, 1, NULL, "dry restitution coefficient e_dry"},
+    {"contact", "contact_time", CFG_DOUBLE, NULL, 1e-15, BIG, NULL, "linear: contact duration t_c (s)"},
+    {"contact", "calibration", CFG_ENUM, "clipped", 1, 0, "clipped|seed",
+     "linear: k_n, gamma_n such that the clipped law gives exactly e_dry and t_c (clipped), or eq. 3.16-3.17 "
+     "of the seed (exact for the unclipped law)"},
+    {"contact", "normal_clip", CFG_BOOL, "true", 1, 0, NULL, "normal force clipped at zero (no attraction)"},
+    {"contact", "kn", CFG_DOUBLE, NULL, 0, BIG, NULL, "linear, parameters = stiffness: normal stiffness (N/m)"},
+    {"contact", "gamma_n", CFG_DOUBLE, "0", 0, BIG, NULL,
+     "linear, parameters = stiffness: normal damping per unit effective mass (1/s)"},
+    {"contact", "kt_ratio", CFG_DOUBLE, "0.2", 0, 10, NULL, "linear: tangential/normal stiffness ratio k_t/k_n"},
+    {"contact", "friction", CFG_DOUBLE, NULL, 0, 1e6, NULL, "Coulomb friction coefficient mu_c (particle-particle)"},
+    {"contact", "wall_friction", CFG_DOUBLE, "-1", -1, 1e6, NULL, "particle-wall friction (-1: the same as friction)"},
+    {"contact", "rolling_friction", CFG_DOUBLE, "0", 0, 10, NULL,
+     "constant-torque rolling resistance mu_r (torque mu_r R* F_n), 0: off"},
+    {"contact", "youngs_modulus", CFG_DOUBLE, NULL, 1e-6, BIG, NULL, "hertz_mindlin: Young's modulus E (Pa)"},
+    {"contact", "poisson_ratio", CFG_DOUBLE, "0.3", 0, 0.499, NULL, "hertz_mindlin: Poisson ratio"},
+    {"contact", "reference_velocity", CFG_DOUBLE, "1", 1e-12, BIG, NULL,
+     "hertz_mindlin: impact velocity of the contact time used for the time step (m/s)"},
+    /* [walls] */
+    {"walls", "faces", CFG_STRING, "auto", 1, 0, NULL,
+     "planar walls on the domain faces: auto (every non-periodic face), none, or a list such as 'x_lo z_lo'"},
+    USER_WALL_KEYS(1), USER_WALL_KEYS(2), USER_WALL_KEYS(3), USER_WALL_KEYS(4), USER_WALL_KEYS(5),
+    USER_WALL_KEYS(6),
+    /* [bed] */
+    {"bed", "type", CFG_ENUM, "none", 1, 0, "none|random|hexagonal",
+     "rough bed of fixed half-grains with centres on a plane: random (2-D random insertion) or hexagonal"},
+    {"bed", "axis", CFG_ENUM, "z", 1, 0, "x|y|z", "normal of the bed plane"},
+    {"bed", "position", CFG_DOUBLE, "0", -BIG, BIG, NULL, "coordinate of the bed grains' centres along axis (m)"},
+    {"bed", "radius", CFG_DOUBLE, NULL, 1e-12, BIG, NULL, "mean radius of the bed grains (m)"},
+    {"bed", "polydispersity", CFG_DOUBLE, "0", 0, 0.9, NULL, "bed radii uniform in [R(1-p), R(1+p)]"},
+    {"bed", "coverage", CFG_DOUBLE, "0.5", 0.01, 0.9, NULL,
+     "random: area fraction covered by the grains' equatorial discs (2-D random insertion jams near 0.547)"},
+    {"bed", "seed", CFG_INT, "2", 0, 2147483647, NULL, "random: seed"},
+    {"bed", "freeze_below", CFG_DOUBLE, "-1e300", -BIG, BIG, NULL,
+     "after the packing preparation, particles with centre below this coordinate along axis become fixed"},
+    /* [packing] */
+    {"packing", "prepare", CFG_BOOL, "false", 1, 0, NULL, "settle the particles to rest before the run"},
+    {"packing", "variant", CFG_ENUM, "dense", 1, 0, "dense|loose|as_is",
+     "settling with no friction (dense), with loose_friction (loose), or with the run's contact law (as_is)"},
+    {"packing", "loose_friction", CFG_DOUBLE, "1.0", 0, 1e6, NULL, "friction coefficient while settling a loose packing"},
+    {"packing", "gravity", CFG_VEC3, NULL, -BIG, BIG, NULL, "gravity while settling (default: dem.gravity)"},
+    {"packing", "max_time", CFG_DOUBLE, "5", 0, BIG, NULL, "longest settling time (s)"},
+    {"packing", "rest_energy", CFG_DOUBLE, "1e-7", 0, BIG, NULL,
+     "at rest when the kinetic energy per mobile particle < rest_energy × m g d (mean m and d)"},
+    {"packing", "output", CFG_STRING, "packing.h5", 1, 0, NULL, "file (in the output directory) of the settled packing"},
+    /* [dem] */
+    {"dem", "gravity", CFG_VEC3, "0 0 -9.81", -BIG, BIG, NULL, "gravity (m/s^2), any direction"},
+    {"dem", "steps_per_contact", CFG_INT, "50", 20, 1000000, NULL, "n_c: time step dt = t_c / n_c"},
+    {"dem", "dt", CFG_DOUBLE, "0", 0, BIG, NULL, "time step (s); 0: t_c / steps_per_contact; must be <= t_c/20"},
+    {"dem", "skin", CFG_DOUBLE, "0.1", 1e-4, 2, NULL, "Verlet skin as a fraction of the largest diameter"},
+    {"dem", "sort_every", CFG_INT, "1", 0, 1000000, NULL,
+     "reorder the particles by cell every this many list rebuilds (0: never)"},
+    {"dem", "threads", CFG_INT, "1", 1, 64, NULL,
+     "OpenMP threads per rank for the pair forces and the integration (each thread sums into its own force "
+     "array; same thread count: same result)"},
+    {"dem", "parallel", CFG_ENUM, "auto", 1, 0, "auto|replicated|split",
+     "several ranks: every rank computes everything (replicated), or the pairs are shared and the forces summed "
+     "(split); auto: split from 4000 particles"},
+    {"dem", "substeps", CFG_INT, "100", 1, 100000000, NULL,
+     "ibmdem run, scene without fluid: DEM steps per step of the run driver (its outputs and checks)"},
+    {"dem", "max_overlap", CFG_DOUBLE, "0.01", 1e-9, 1, NULL,
+     "stop (with a checkpoint) when an overlap exceeds this fraction of the smaller diameter"},
+    {"dem", "series_interval", CFG_DOUBLE, "0", 0, BIG, NULL,
+     "dem_run_case: time between lines of dem_series.csv (s); 0: t_end/500"},
+    {"dem", "rest_after", CFG_DOUBLE, "0", 0, BIG, NULL,
+     "the grains' rate of change (rms velocity / mean diameter) counts for time.steady_tol after this time (s)"},
+    {NULL, NULL, 0, NULL, 0, 0, NULL, NULL}};
+
+void dem_register_keys(void) { cfg_schema_add(dem_keys); }
+
+static const char *face_names[3][2] = {{"x_lo", "x_hi"}, {"y_lo", "y_hi"}, {"z_lo", "z_hi"}};
+
+static int has_word(const char *list, const char *w)
+{
+    const size_t lw = strlen(w);
+    for (const char *p = list; (p = strstr(p, w)); p += lw) {
+        const int start = p == list || p[-1] == ' ' || p[-1] == ',';
+        const int end = p[lw] == 0 || p[lw] == ' ' || p[lw] == ',';
+        if (start && end) return 1;
+    }
+    return 0;
+}
+
+static void config_walls(dem_t *d, cfg_t *cfg)
+{
+    const char *faces = cfg_string(cfg, "walls", "faces");
+    const int autow = !strcmp(faces, "auto"), none = !strcmp(faces, "none");
+    if (!autow && !none) {
+        /* every word must be a face name */
+        char buf[256];
+        snprintf(buf, sizeof buf, "%s", faces);
+        for (char *tok = strtok(buf, " ,"); tok; tok = strtok(NULL, " ,")) {
+            int ok = 0;
+            for (int a = 0; a < 3; a++)
+                for (int s = 0; s < 2; s++) ok |= !strcmp(tok, face_names[a][s]);
+            if (!ok) cfg_fail(cfg, "walls", "faces", "'%s' is not auto, none or a face name (x_lo ... z_hi)", tok);
+        }
+    }
+    for (int a = 0; a < 3; a++)
+        for (int s = 0; s < 2; s++) {
+            const int want = autow ? !d->periodic[a] : (!none && has_word(faces, face_names[a][s]));
+            if (!want) continue;
+            if (d->periodic[a])
+                cfg_fail(cfg, "walls", "faces", "face %s is periodic and cannot carry a wall", face_names[a][s]);
+            double p[3] = {d->lo[0], d->lo[1], d->lo[2]}, n[3] = {0, 0, 0};
+            p[a] = s ? d->hi[a] : d->lo[a];
+            n[a] = s ? -1.0 : 1.0;
+            dem_add_wall(d, face_names[a][s], p, n, NULL, INFINITY);
+        }
+    for (int w = 1; w <= DEM_MAX_USER_WALLS; w++) {
+        char kp[32], kn[32], kv[32], kr[32], name[16];
+        snprintf(kp, sizeof kp, "wall%d_point", w);
+        snprintf(kn, sizeof kn, "wall%d_normal", w);
+        snprintf(kv, sizeof kv, "wall%d_velocity", w);
+        snprintf(kr, sizeof kr, "wall%d_remove_time", w);
+        if (!cfg_has(cfg, "walls", kp) && !cfg_has(cfg, "walls", kn)) continue;
+        double p[3], n[3], v[3];
+        cfg_vec3(cfg, "walls", kp, p);
+        cfg_vec3(cfg, "walls", kn, n);
+        cfg_vec3(cfg, "walls", kv, v);
+        if (n[0] * n[0] + n[1] * n[1] + n[2] * n[2] == 0) cfg_fail(cfg, "walls", kn, "the normal must not be zero");
+        const double tr = cfg_double(cfg, "walls", kr);
+        snprintf(name, sizeof name, "wall%d", w);
+        dem_add_wall(d, name, p, n, v, tr < 0 ? INFINITY : tr);
+    }
+}
+
+/* 2-D random (or hexagonal) layer of fixed grains with centres on a plane. */
+void dem_config_bed(dem_t *d, cfg_t *cfg)
+{
+    const int type = cfg_enum(cfg, "bed", "type");
+    if (type == 0) return;
+    const int ax = cfg_enum(cfg, "bed", "axis");
+    const int a1 = (ax + 1) % 3, a2 = (ax + 2) % 3;
+    const double pos = cfg_double(cfg, "bed", "position");
+    const double R = cfg_double(cfg, "bed", "radius");
+    const double poly = cfg_double(cfg, "bed", "polydispersity");
+    const double rho = cfg_double(cfg, "particles", "density");
+    if (pos < d->lo[ax] || pos > d->hi[ax]) cfg_fail(cfg, "bed", "position", "outside the domain");
+    const double L1 = d->L[a1], L2 = d->L[a2];
+    const double v0[3] = {0, 0, 0};
+    if (type == 2) {
+        /* hexagonal: rows along a1 with spacing 2R, rows 2R sin 60° apart */
+        const int n1 = (int)floor(L1 / (2 * R) + 1e-9);
+        const int n2 = (int)floor(L2 / (sqrt(3.0) * R) + 1e-9);
+        if (n1 < 1 || n2 < 1) cfg_fail(cfg, "bed", "radius", "larger than the bed plane");
+        const double s1 = L1 / n1, s2 = L2 / n2;
+        for (int j = 0; j < n2; j++)
+            for (int i = 0; i < n1; i++) {
+                double x[3];
+                x[ax] = pos;
+                x[a1] = d->lo[a1] + (i + 0.5 + 0.5 * (j % 2)) * s1;
+                x[a2] = d->lo[a2] + (j + 0.5) * s2;
+                if (x[a1] >= d->hi[a1]) {
+                    if (!d->periodic[a1]) continue;
+                    x[a1] -= L1;
+                }
+                dem_add_particle(d, x, v0, R, rho, 1);
+            }
+        msg("dem: hexagonal bed of %d x %d fixed grains (R = %g m) at %c = %g m\n", n1, n2, R, "xyz"[ax], pos);
+        return;
+    }
+    /* random sequential insertion of discs in the plane until the coverage */
+    const double cover = cfg_double(cfg, "bed", "coverage");
+    dem_rng_t g;
+    dem_rng_seed(&g, (uint64_t)cfg_int(cfg, "bed", "seed") + 7777);
+    const double area = L1 * L2;
+    double covered = 0;
+    int nb = 0, maxcap = 1024;
+    double *c1 = malloc(maxcap * sizeof(double)), *c2 = malloc(maxcap * sizeof(double)),
+           *cr = malloc(maxcap * sizeof(double));
+    long fails = 0;
+    while (covered < cover * area) {
+        const double r = R * (1 + poly * (2 * dem_rng_uniform(&g) - 1));
+        int placed = 0;
+        for (int att = 0; att < 20000 && !placed; att++) {
+            double p1 = d->lo[a1] + dem_rng_uniform(&g) * L1, p2 = d->lo[a2] + dem_rng_uniform(&g) * L2;
+            if (!d->periodic[a1] && (p1 < d->lo[a1] + r || p1 > d->hi[a1] - r)) continue;
+            if (!d->periodic[a2] && (p2 < d->lo[a2] + r || p2 > d->hi[a2] - r)) continue;
+            int ok = 1;
+            for (int k = 0; k < nb && ok; k++) {
+                double e1 = p1 - c1[k], e2 = p2 - c2[k];
+                if (d->periodic[a1]) e1 -= L1 * round(e1 / L1);
+                if (d->periodic[a2]) e2 -= L2 * round(e2 / L2);
+                const double rr = r + cr[k];
+                if (e1 * e1 + e2 * e2 < rr * rr) ok = 0;
+            }
+            if (!ok) continue;
+            if (nb == maxcap) {
+                maxcap *= 2;
+                c1 = realloc(c1, maxcap * sizeof(double));
+                c2 = realloc(c2, maxcap * sizeof(double));
+                cr = realloc(cr, maxcap * sizeof(double));
+            }
+            c1[nb] = p1;
+            c2[nb] = p2;
+            cr[nb] = r;
+            nb++;
+            covered += M_PI * r * r;
+            placed = 1;
+        }
+        if (!placed && ++fails > 5)
+            cfg_fail(cfg, "bed", "coverage", "random insertion jammed at coverage %.3f (asked %.3f)", covered / area,
+                     cover);
+    }
+    for (int k = 0; k < nb; k++) {
+        double x[3];
+        x[ax] = pos;
+        x[a1] = c1[k];
+        x[a2] = c2[k];
+        dem_add_particle(d, x, v0, cr[k], rho, 1);
+    }
+    free(c1);
+    free(c2);
+    free(cr);
+    msg("dem: random bed of %d fixed grains (coverage %.3f) at %c = %g m\n", nb, covered / area, "xyz"[ax], pos);
+}
+
+void dem_freeze_below(dem_t *d, cfg_t *cfg)
+{
+    const double h = cfg_double(cfg, "bed", "freeze_below");
+    if (h <= -1e299) return;
+    const int ax = cfg_enum(cfg, "bed", "axis");
+    dem_sync_velocities(d);
+    int nf = 0;
+    for (int i = 0; i < d->n; i++) {
+        if (d->fixed[i] || d->x[3 * i + ax] >= h) continue;
+        d->fixed[i] = 1;
+        d->invm[i] = d->invI[i] = 0.0;
+        for (int a = 0; a < 3; a++) d->v[3 * i + a] = d->w[3 * i + a] = 0.0;
+        nf++;
+    }
+    d->ready = 0;
+    msg("dem: %d particles below %c = %g m are now fixed (rough bed)\n", nf, "xyz"[ax], h);
+}
+
+void dem_config_particles(dem_t *d, cfg_t *cfg)
+{
+    const int source = cfg_enum(cfg, "particles", "source");
+    if (source == 1) {
+        double lo[3], hi[3], v0[3];
+        for (int a = 0; a < 3; a++) {
+            lo[a] = d->lo[a];
+            hi[a] = d->hi[a];
+        }
+        if (cfg_has(cfg, "particles", "region_lo")) cfg_vec3(cfg, "particles", "region_lo", lo);
+        if (cfg_has(cfg, "particles", "region_hi")) cfg_vec3(cfg, "particles", "region_hi", hi);
+        for (int a = 0; a < 3; a++)
+            if (!(hi[a] > lo[a])) cfg_fail(cfg, "particles", "region_hi", "must exceed region_lo in every component");
+        cfg_vec3(cfg, "particles", "velocity", v0);
+        const long count = cfg_int(cfg, "particles", "count");
+        const double phi = cfg_double(cfg, "particles", "volume_fraction");
+        if ((count > 0) == (phi > 0)) cfg_fail(cfg, "particles", "count", "give either count or volume_fraction");
+        const char *why = NULL;
+        const int n0 = d->n;
+        if (dem_insert_random(d, lo, hi, count, phi, cfg_double(cfg, "particles", "radius"),
+                              cfg_double(cfg, "particles", "polydispersity"), cfg_double(cfg, "particles", "density"),
+                              v0, cfg_double(cfg, "particles", "velocity_spread"),
+                              (unsigned long)cfg_int(cfg, "particles", "seed"), &why) != 0)
+            cfg_fail(cfg, "particles", phi > 0 ? "volume_fraction" : "count", "%s", why);
+        msg("dem: inserted %d particles at random\n", d->n - n0);
+    } else if (source == 2) {
+        dem_read_checkpoint(d, cfg_string(cfg, "particles", "file"));
+    } else if (source == 3) {
+        double blo[3], bhi[3];
+        dem_read_lammps_data(d, cfg_string(cfg, "particles", "file"), blo, bhi, 0);
+    }
+}
+
+/* Random sequential insertion in [lo, hi] (centres at least R from the
+ * region's faces, except along a periodic direction the region spans),
+ * avoiding the particles already present. */
+int dem_insert_random(dem_t *d, const double lo[3], const double hi[3], long count, double phi, double rmean,
+                      double poly, double rho, const double v0[3], double vspread, unsigned long seed,
+                      const char **why)
+{
+    static char buf[256];
+    dem_rng_t g;
+    dem_rng_seed(&g, seed);
+    const double rmx = rmean * (1 + poly);
+    double rmax_all = rmx;
+    for (int i = 0; i < d->n; i++)
+        if (d->r[i] > rmax_all) rmax_all = d->r[i];
+    int wrap[3];
+    double span[3];
+    for (int a = 0; a < 3; a++) {
+        wrap[a] = d->periodic[a] && lo[a] <= d->lo[a] && hi[a] >= d->hi[a];
+        span[a] = wrap[a] ? d->L[a] : hi[a] - lo[a];
+    }
+    /* radii first: the count, or until the volume fraction is reached */
+    const double vol = span[0] * span[1] * span[2];
+    long cap = count > 0 ? count : (long)(phi * vol / dem_sphere_volume(rmean * (1 - poly))) + 16;
+    double *rad = malloc((size_t)cap * sizeof(double));
+    long nr = 0;
+    double vsum = 0;
+    while (count > 0 ? nr < count : vsum < phi * vol) {
+        if (nr == cap) break;
+        rad[nr] = rmean * (1 + poly * (2 * dem_rng_uniform(&g) - 1));
+        vsum += dem_sphere_volume(rad[nr]);
+        nr++;
+    }
+    /* hash grid over the region (cells ≥ 2 R_max) holding existing and new particles */
+    int nc[3];
+    double cs[3], glo[3];
+    for (int a = 0; a < 3; a++) {
+        glo[a] = wrap[a] ? d->lo[a] : lo[a] - rmax_all;
+        const double ext = wrap[a] ? d->L[a] : hi[a] - lo[a] + 2 * rmax_all;
+        nc[a] = (int)floor(ext / (2 * rmax_all));
+        if (nc[a] < 1) nc[a] = 1;
+        if (nc[a] > 512) nc[a] = 512;
+        cs[a] = ext / nc[a];
+    }
+    const long ncell = (long)nc[0] * nc[1] * nc[2];
+    int *head = malloc((size_t)ncell * sizeof(int));
+    for (long c = 0; c < ncell; c++) head[c] = -1;
+    const int ntot = d->n + (int)nr;
+    int *next = malloc((size_t)ntot * sizeof(int));
+    double *px = malloc(3 * (size_t)ntot * sizeof(double)), *pr = malloc((size_t)ntot * sizeof(double));
+    int np = 0;
+#define CELL_OF(p, c)                                                                    \
+    do {                                                                                 \
+        for (int a_ = 0; a_ < 3; a_++) {                                                 \
+            int m_ = (int)floor(((p)[a_] - glo[a_]) / cs[a_]);                           \
+            if (wrap[a_]) m_ = ((m_ % nc[a_]) + nc[a_]) % nc[a_];                        \
+            c[a_] = m_ < 0 ? 0 : (m_ >= nc[a_] ? nc[a_] - 1 : m_);                       \
+        }                                                                                \
+    } while (0)
+    for (int i = 0; i < d->n; i++) {
+        int c[3];
+        CELL_OF(&d->x[3 * i], c);
+        /* existing particles outside the grid are clamped into the border cells */
+        const long cc = ((long)c[2] * nc[1] + c[1]) * nc[0] + c[0];
+        for (int a = 0; a < 3; a++) px[3 * np + a] = d->x[3 * i + a];
+        pr[np] = d->r[i];
+        next[np] = head[cc];
+        head[cc] = np++;
+    }
+    long placed = 0;
+    const long max_attempts = 200000;
+    for (long q = 0; q < nr; q++) {
+        const double r = rad[q];
+        int ok = 0;
+        double p[3];
+        for (long att = 0; att < max_attempts && !ok; att++) {
+            for (int a = 0; a < 3; a++) {
+                if (wrap[a])
+                    p[a] = d->lo[a] + dem_rng_uniform(&g) * d->L[a];
+                else
+                    p[a] = lo[a] + r + dem_rng_uniform(&g) * (hi[a] - lo[a] - 2 * r);
+            }
+            int c[3];
+            CELL_OF(p, c);
+            ok = 1;
+            for (int oz = -1; oz <= 1 && ok; oz++)
+                for (int oy = -1; oy <= 1 && ok; oy++)
+                    for (int ox = -1; ox <= 1 && ok; ox++) {
+                        int cc[3] = {c[0] + ox, c[1] + oy, c[2] + oz};
+                        int skip = 0;
+                        for (int a = 0; a < 3; a++) {
+                            if (cc[a] < 0 || cc[a] >= nc[a]) {
+                                if (wrap[a] && nc[a] >= 3)
+                                    cc[a] = (cc[a] + nc[a]) % nc[a];
+                                else
+                                    skip = 1;
+                            }
+                        }
+                        if (skip) continue;
+                        for (int k = head[((long)cc[2] * nc[1] + cc[1]) * nc[0] + cc[0]]; k >= 0; k = next[k]) {
+                            double r2 = 0;
+                            for (int a = 0; a < 3; a++) {
+                                double e = p[a] - px[3 * k + a];
+                                if (d->periodic[a]) e -= d->L[a] * round(e / d->L[a]);
+                                r2 += e * e;
+                            }
+                            const double rr = r + pr[k];
+                            if (r2 < rr * rr) {
+                                ok = 0;
+                                break;
+                            }
+                        }
+                    }
+            /* with fewer than 3 cells along a wrapped direction the stencil
+             * misses images: check every particle (small systems only) */
+            if (ok && ((wrap[0] && nc[0] < 3) || (wrap[1] && nc[1] < 3) || (wrap[2] && nc[2] < 3))) {
+                for (int k = 0; k < np && ok; k++) {
+                    double r2 = 0;
+                    for (int a = 0; a < 3; a++) {
+                        double e = p[a] - px[3 * k + a];
+                        if (d->periodic[a]) e -= d->L[a] * round(e / d->L[a]);
+                        r2 += e * e;
+                    }
+                    if (r2 < (r + pr[k]) * (r + pr[k])) ok = 0;
+                }
+            }
+        }
+        if (!ok) break;
+        int c[3];
+        CELL_OF(p, c);
+        const long cc = ((long)c[2] * nc[1] + c[1]) * nc[0] + c[0];
+        for (int a = 0; a < 3; a++) px[3 * np + a] = p[a];
+        pr[np] = r;
+        next[np] = head[cc];
+        head[cc] = np++;
+        placed++;
+    }
+#undef CELL_OF
+    int rc = 0;
+    if (placed < nr) {
+        double vp = 0;
+        for (long q = 0; q < placed; q++) vp += dem_sphere_volume(rad[q]);
+        snprintf(buf, sizeof buf,
+                 "random insertion jammed after %ld of %ld particles (volume fraction %.3f of the region): use a "
+                 "larger region or fewer particles",
+                 placed, nr, vp / vol);
+        *why = buf;
+        rc = 1;
+    } else {
+        const int first = np - (int)placed;
+        for (int k = first; k < np; k++) {
+            double v[3];
+            for (int a = 0; a < 3; a++) v[a] = v0[a] + vspread * (2 * dem_rng_uniform(&g) - 1);
+            dem_add_particle(d, &px[3 * k], v, pr[k], rho, 0);
+        }
+    }
+    free(rad);
+    free(head);
+    free(next);
+    free(px);
+    free(pr);
+    return rc;
+}
+
+dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
+{
+    dem_t *d = calloc(1, sizeof *d);
+    d->comm = comm;
+    MPI_Comm_rank(comm, &d->rank);
+    MPI_Comm_size(comm, &d->nranks);
+    if (cfg_enum(cfg, "domain", "geometry") != 0)
+        cfg_fail(cfg, "domain", "geometry", "the DEM (spheres) needs geometry = 3d");
+    const int source = cfg_enum(cfg, "particles", "source");
+    double L[3], o[3];
+    if (source == 3 && !cfg_has(cfg, "domain", "length")) {
+        /* the box of the LAMMPS data file */
+        double blo[3], bhi[3];
+        dem_read_lammps_data(d, cfg_string(cfg, "particles", "file"), blo, bhi, 1);
+        for (int a = 0; a < 3; a++) {
+            o[a] = blo[a];
+            L[a] = bhi[a] - blo[a];
+        }
+    } else {
+        cfg_vec3(cfg, "domain", "length", L);
+        cfg_vec3(cfg, "domain", "origin", o);
+    }
+    for (int a = 0; a < 3; a++) {
+        if (!(L[a] > 0)) cfg_fail(cfg, "domain", "length", "every component must be positive");
+        d->lo[a] = o[a];
+        d->L[a] = L[a];
+        d->hi[a] = o[a] + L[a];
+        const int plo = cfg_enum(cfg, "boundary", face_names[a][0]) == 0,
+                  phi = cfg_enum(cfg, "boundary", face_names[a][1]) == 0;
+        if (plo != phi)
+            cfg_fail(cfg, "boundary", face_names[a][plo ? 1 : 0], "must be periodic too: %s is periodic",
+                     face_names[a][plo ? 0 : 1]);
+        d->periodic[a] = plo;
+        d->any_periodic |= plo;
+    }
+    /* contact */
+    d->law = dem_contact_law_find(cfg_string(cfg, "contact", "law"));
+    if (!d->law) cfg_fail(cfg, "contact", "law", "unknown contact law");
+    dem_contact_prm_t *cp = &d->cp;
+    cp->clip = cfg_bool(cfg, "contact", "normal_clip");
+    cp->mu = cfg_double(cfg, "contact", "friction");
+    const double mw = cfg_double(cfg, "contact", "wall_friction");
+    cp->mu_wall = mw < 0 ? cp->mu : mw;
+    cp->mu_roll = cfg_double(cfg, "contact", "rolling_friction");
+    d->law->setup(d, cfg);
+    /* integration and neighbour search */
+    cfg_vec3(cfg, "dem", "gravity", d->gravity);
+    d->n_c = cfg_int(cfg, "dem", "steps_per_contact");
+    d->dt_user = cfg_double(cfg, "dem", "dt");
+    d->skin_rel = cfg_double(cfg, "dem", "skin");
+    d->sort_every = cfg_int(cfg, "dem", "sort_every");
+    d->max_overlap_allowed = cfg_double(cfg, "dem", "max_overlap");
+    d->parallel_mode = cfg_enum(cfg, "dem", "parallel");
+    d->nthreads = cfg_int(cfg, "dem", "threads");
+#ifndef _OPENMP
+    if (d->nthreads > 1) cfg_fail(cfg, "dem", "threads", "this build has no OpenMP (compile src/dem with -fopenmp)");
+#endif
+    d->hist_update = 1;
+    config_walls(d, cfg);
+    const int src = cfg_enum(cfg, "particles", "source");
+    if (src == 2 && cfg_enum(cfg, "bed", "type") != 0)
+        cfg_fail(cfg, "bed", "type", "must be none when the particles come from a packing file (it holds the bed)");
+    dem_config_bed(d, cfg);
+    dem_config_particles(d, cfg);
+    /* a time step too large for the contact time: stop now when it is known */
+    if (d->dt_user > 0) {
+        const double tc = d->law->contact_time(d);
+        if (isfinite(tc) && d->dt_user > tc / 20.0 * (1 + 1e-12))
+            cfg_fail(cfg, "dem", "dt", "%g s is too large for the contact time t_c = %g s: it must not exceed t_c/20 = %g s",
+                     d->dt_user, tc, tc / 20.0);
+    }
+    return d;
+}

@@ -1,0 +1,203 @@
+/* dem_private.h — the DEM data structure and the contact-law interface.
+ *
+ * Shared by the files of src/dem only.  A new contact law is a new file
+ * src/dem/contact_<name>.c defining a dem_contact_law_t (see
+ * contact_linear.c) and one line in contact_registry.c.
+ */
+#ifndef IBMDEM_DEM_PRIVATE_H
+#define IBMDEM_DEM_PRIVATE_H
+
+#include <math.h>
+#include <stdint.h>
+
+#include "dem.h"
+
+#define DEM_MAX_WALLS 16
+#define DEM_MAX_USER_WALLS 6
+#define DEM_MAX_THREADS 64
+/* bytes of the pair loop's work space: 128 contacts × (3 ints + 38 doubles) */
+#define DEM_KERNEL_BLOCK_BYTES (128 * (3 * sizeof(int) + 40 * sizeof(double)))
+
+typedef struct {
+    char name[24];
+    double p[3];     /* a point of the plane */
+    double n[3];     /* unit normal pointing to the particles' side */
+    double vel[3];   /* velocity (translation) */
+    double remove_time; /* the wall disappears at this time (INFINITY: never) */
+    int active;
+    double moved;    /* distance moved since the last list build */
+    /* contact list: particles within r + skin at the last build */
+    int nlist, cap;
+    int *idx;
+    unsigned char *on; /* 1 while in contact (overlap) */
+    double *hist;    /* tangential spring ξ (3 per entry) */
+    double force[3]; /* force exerted by the particles on the wall, last step */
+} dem_wall_t;
+
+/* Contact parameters: the common part (tangential spring, friction, rolling)
+ * and the fields of each law.  Laws read what they need in setup(). */
+typedef struct {
+    int clip;            /* normal force clipped at zero (decision 3) */
+    double kt_ratio;     /* linear: k_t = kt_ratio k_n */
+    double mu, mu_wall;  /* Coulomb friction: particle–particle, particle–wall */
+    double mu_roll;      /* rolling resistance coefficient (constant torque), 0 = off */
+    /* linear spring–dashpot: F_n = (kn_abs + m* kn_rel) δ + m* gn_rel δ̇ */
+    double kn_abs, kn_rel, gn_rel;
+    double restitution, tc_given;
+    /* Hertz–Mindlin */
+    double E_star, G_star, beta_damp, v_ref;
+    char summary[256]; /* one line describing the law and its constants */
+} dem_contact_prm_t;
+
+typedef struct dem_contact_law {
+    const char *name;
+    /* Read the law's keys from [contact] into d->cp (stops on bad input). */
+    void (*setup)(dem_t *d, cfg_t *cfg);
+    /* Shortest contact duration among the particles present (for dt). */
+    double (*contact_time)(const dem_t *d);
+    /* Forces and torques of the rank's share of the particle pairs. */
+    void (*pair_forces)(dem_t *d);
+    /* Forces and torques of the rank's share of one wall's contacts. */
+    void (*wall_forces)(dem_t *d, dem_wall_t *w);
+    /* Elastic energy of one contact (normal + tangential springs). */
+    double (*energy)(const dem_contact_prm_t *cp, double delta, double meff, double reff, double xi2);
+} dem_contact_law_t;
+
+const dem_contact_law_t *dem_contact_law_find(const char *name);
+/* The "a|b|c" list of the registered laws (schema choices). */
+extern const char dem_contact_law_choices[];
+
+struct dem {
+    MPI_Comm comm;
+    int rank, nranks;
+    int parallel_mode;   /* 0 auto, 1 replicated, 2 split */
+    int split;           /* 1: the pairs are shared among the ranks, forces summed */
+    int split_decided;
+
+    /* particles: structure of arrays (3-vectors stored as x,y,z) */
+    int n, cap;
+    double *x, *v, *w;   /* position, velocity, angular velocity */
+    double *f, *t;       /* force and torque (one block of 6n: f then t) */
+    double *dv, *dw;     /* dt/2 × acceleration of the previous step (predictor) */
+    double *fext, *text; /* external force and torque (immersed boundary) */
+    double *fc;          /* contact force of the last step (diagnostics), 3n */
+    double *r, *invm, *invI, *rho;
+    long *id;
+    unsigned char *fixed;
+    long next_id;
+    int pending_kick;    /* 1: v, w are half-step values; the final kick is pending */
+
+    /* domain */
+    double lo[3], hi[3], L[3];
+    int periodic[3];
+    int any_periodic;
+
+    /* walls */
+    int nwall;
+    dem_wall_t wall[DEM_MAX_WALLS];
+
+    /* contact law */
+    const dem_contact_law_t *law;
+    dem_contact_prm_t cp;
+
+    /* time integration */
+    double dt, dt_user, tc;
+    int n_c;
+    double time;
+    long step;
+    double gravity[3];
+    double max_overlap_allowed;
+    int ready;           /* lists built and forces of the current state computed */
+    int hist_update;     /* 0 while computing the forces of the initial state */
+    int use_ext;         /* the external force/torque arrays were handed out */
+
+    /* neighbour search: linked cells + Verlet list with skin */
+    double skin;         /* absolute skin (m) */
+    double skin_rel;     /* skin as a fraction of the largest diameter */
+    double rmax;
+    int nc[3];
+    double csize[3];
+    long ncell;
+    int *cell_start;     /* ncell + 1 */
+    int *cell_of;        /* cell of each particle at the last build */
+    int *perm;           /* work: new → old index */
+    double disp_bound;   /* upper bound of any particle's displacement since the build */
+    int sort_every, builds_since_sort;
+    long rebuilds;
+    /* half neighbour list in CSR form */
+    int *nb_start;       /* n + 1 */
+    int *nb_j;
+    unsigned char *nb_img; /* periodic image of j (index into shift), only if any_periodic */
+    unsigned char *nb_on;  /* 1 while the pair overlaps */
+    double *nb_hist;       /* tangential spring ξ of the pair, 3 per entry */
+    long nb_n, nb_cap;
+    int nb_n_rows;       /* particles (rows) covered by the list */
+    double shift[27][3];
+    void *kernel_block;  /* work space of the pair loop (dem_kernel.inc), one per thread: */
+    void *tblock[DEM_MAX_THREADS];
+    /* threads (OpenMP, [dem] threads): rows [trow[t], trow[t+1]) of the
+     * rank's share; force and torque arrays of threads 1.. (6n each) */
+    int nthreads;
+    int trow[DEM_MAX_THREADS + 1];
+    double *tforce[DEM_MAX_THREADS];
+    int tforce_cap;
+    /* the rank's share: rows [row_lo, row_hi) of the list */
+    int row_lo, row_hi;
+
+    /* diagnostics of the last step */
+    long n_contacts, n_wall_contacts;
+    long n_starts;       /* contacts started on this rank since the creation (pairs and walls) */
+    double max_overlap;
+    char errmsg[512];
+    /* snapshots written (for the XDMF index) */
+    int nsnap, snap_cap;
+    double *snap_t;
+    long *snap_n;
+    int *snap_index;
+    /* timers */
+    double t_pair, t_wall, t_build, t_integ, t_comm;
+};
+
+/* ---- neighbour search (dem_neigh.c) ---- */
+/* Rebuild the cell grid, reorder particles (if due), rebuild the pair and
+ * wall lists keeping the contact histories.  Returns DEM_OK or
+ * DEM_ERR_LEFT_DOMAIN / DEM_ERR_NAN (message in d->errmsg). */
+dem_status_t dem_neigh_build(dem_t *d);
+void dem_neigh_free(dem_t *d);
+/* Split runs: every rank gets the springs of every pair and wall contact. */
+void dem_neigh_gather(dem_t *d);
+/* The rank's share of the rows after a build. */
+void dem_neigh_partition(dem_t *d);
+
+/* ---- internal helpers (dem.c) ---- */
+void dem_grow(dem_t *d, int need);
+dem_status_t dem_set_dt(dem_t *d);
+/* Checks that need the particles (periodic lengths); sets the skin and image shifts. */
+void dem_check_scene(dem_t *d);
+void dem_decide_split(dem_t *d);
+/* Mass of the lightest mobile particle (INFINITY if none); smallest radius in *rmin. */
+double dem_lightest_mass(const dem_t *d, double *rmin);
+void dem_compute_forces(dem_t *d);
+/* Finish a pending half kick so that v, w are full-step values. */
+void dem_sync_velocities(dem_t *d);
+double dem_elastic_energy(const dem_t *d);
+void dem_config_particles(dem_t *d, cfg_t *cfg);
+void dem_config_bed(dem_t *d, cfg_t *cfg);
+void dem_freeze_below(dem_t *d, cfg_t *cfg);
+int dem_insert_random(dem_t *d, const double lo[3], const double hi[3], long count, double phi, double rmean,
+                      double poly, double rho, const double v0[3], double vspread, unsigned long seed,
+                      const char **why);
+void dem_read_lammps_data(dem_t *d, const char *path, double box_lo[3], double box_hi[3], int read_box);
+void dem_add_wall(dem_t *d, const char *name, const double p[3], const double n[3], const double vel[3],
+                  double remove_time);
+
+/* Small deterministic random generator (splitmix64 / xoshiro256**). */
+typedef struct {
+    uint64_t s[4];
+} dem_rng_t;
+void dem_rng_seed(dem_rng_t *g, uint64_t seed);
+double dem_rng_uniform(dem_rng_t *g); /* [0, 1) */
+
+static inline double dem_sphere_volume(double r) { return 4.0 / 3.0 * M_PI * r * r * r; }
+
+#endif

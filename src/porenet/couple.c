@@ -1,0 +1,49 @@
+/* couple.c — the pore network coupled with the DEM engine (DEM–PFV, thesis
+ * §4.2, fig. 4.3): the fluid forces of the pore pressures are the external
+ * forces of the particles, and the pore volume rates come from their motion. */
+#include <math.h>
+#include <stdlib.h>
+
+#include "dem.h"
+#include "porenet.h"
+
+int pn_model_couple_dem(pn_model_t *m, dem_t *d, const double g[3], double dt)
+{
+    const int n = dem_count(d);
+    const double *x = dem_positions(d), *r = dem_radii(d);
+    const long *id = dem_ids(d);
+    if (n != m->n || !m->xid) {
+        m->xid = realloc(m->xid, 3 * (size_t)n * sizeof *m->xid);
+        m->rid = realloc(m->rid, (size_t)n * sizeof *m->rid);
+    }
+    /* the model keeps its own (id) order: the pore volume rates compare the
+     * positions of the same sphere at two steps */
+    for (int i = 0; i < n; i++) {
+        const long k = id[i];
+        for (int a = 0; a < 3; a++) m->xid[3 * k + a] = x[3 * i + a];
+        m->rid[k] = r[i];
+    }
+    if (pn_model_step(m, n, m->xid, m->rid, dt)) return -1;
+    double *fe = dem_ext_force(d), *te = dem_ext_torque(d);
+    for (int i = 0; i < n; i++) {
+        const long k = id[i];
+        /* buoyancy of the hydrostatic pressure (the model solves the excess one) */
+        const double vs = 4.0 / 3.0 * M_PI * r[i] * r[i] * r[i];
+        for (int a = 0; a < 3; a++) {
+            fe[3 * i + a] = m->f[3 * k + a] - m->rho_f * vs * g[a];
+            te[3 * i + a] = 0;
+        }
+    }
+    return 0;
+}
+
+double pn_coupled_dt(const pn_model_t *m, const dem_t *d)
+{
+    const int n = dem_count(d);
+    const double *r = dem_radii(d);
+    const unsigned char *fixed = dem_fixed(d);
+    double lim = INFINITY;
+    for (int i = 0; i < n; i++)
+        if (!fixed[i]) lim = fmin(lim, dem_mass(d, i) / (200.0 * m->prm.mu * 2.0 * r[i])); /* (4.20) */
+    return m->dt_factor * lim;
+}

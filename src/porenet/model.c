@@ -1,0 +1,197 @@
+/* model.c — the pore network as used in a run: triangulate, build and
+ * factorise when due (thesis fig. 5.9, step 2), then every step the pore
+ * volume rates, the back-substitution and the forces (steps 3–5). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "porenet.h"
+#include "util.h"
+
+void pn_model_free(pn_model_t *m)
+{
+    pn_solver_free(m->sol);
+    pn_network_free(&m->net);
+    pn_tri_free(&m->tri);
+    free(m->p);
+    free(m->vol);
+    free(m->vol_prev);
+    free(m->dvdt);
+    free(m->x_prev);
+    free(m->f);
+    free(m->fp);
+    free(m->fv);
+    free(m->x_cont);
+    free(m->xid);
+    free(m->rid);
+    free(m->snap_time);
+    free(m->snap_counts);
+    m->snap_time = NULL;
+    m->snap_counts = NULL;
+    m->nsnap = 0;
+    m->sol = NULL;
+    m->p = m->vol = m->vol_prev = m->dvdt = m->x_prev = m->f = m->fp = m->fv = NULL;
+    m->x_cont = m->xid = m->rid = NULL;
+    m->built = 0;
+}
+
+int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
+{
+    pn_solver_free(m->sol);
+    m->sol = NULL;
+    pn_network_free(&m->net);
+    pn_tri_free(&m->tri);
+    double t0 = wtime();
+    if (pn_triangulate(&m->dom, n, x, r, m->margin, &m->tri, m->err, sizeof m->err)) return -1;
+    double t1 = wtime();
+    if (pn_network_build(&m->dom, &m->prm, &m->tri, x, r, n, &m->net, m->err, sizeof m->err)) return -1;
+    double t2 = wtime();
+    m->sol = pn_solver_create(&m->dom, &m->net, m->kind, m->pcg_tol, m->err, sizeof m->err);
+    if (!m->sol) return -1;
+    m->t_tri = t1 - t0;
+    m->t_net = t2 - t1;
+    m->t_factor = wtime() - t2;
+    int np = m->net.npore;
+    m->p = realloc(m->p, (size_t)np * sizeof *m->p);
+    m->vol = realloc(m->vol, (size_t)np * sizeof *m->vol);
+    m->vol_prev = realloc(m->vol_prev, (size_t)np * sizeof *m->vol_prev);
+    m->dvdt = realloc(m->dvdt, (size_t)np * sizeof *m->dvdt);
+    memset(m->p, 0, (size_t)np * sizeof *m->p);
+    if (n != m->n || !m->f) {
+        m->f = realloc(m->f, 3 * (size_t)n * sizeof *m->f);
+        m->fp = realloc(m->fp, 3 * (size_t)n * sizeof *m->fp);
+        m->fv = realloc(m->fv, 3 * (size_t)n * sizeof *m->fv);
+        m->x_prev = realloc(m->x_prev, 3 * (size_t)n * sizeof *m->x_prev);
+        m->x_cont = realloc(m->x_cont, 3 * (size_t)n * sizeof *m->x_cont);
+    }
+    m->n = n;
+    m->built = 1;
+    m->n_retri++;
+    m->eps_acc = 0;
+    return 0;
+}
+
+/* A sphere crossed a periodic face since the previous step (its centre was
+ * brought back into the box): the topology, built with its old position and
+ * images, no longer follows it. */
+static int wrapped(const pn_model_t *m, int n, const double *x)
+{
+    for (int a = 0; a < 3; a++) {
+        if (!m->dom.periodic[a]) continue;
+        const double half = 0.5 * (m->dom.hi[a] - m->dom.lo[a]);
+        for (int i = 0; i < n; i++)
+            if (fabs(x[3 * i + a] - m->x_prev[3 * i + a]) > half) return 1;
+    }
+    return 0;
+}
+
+int pn_model_step(pn_model_t *m, int n, const double *x, const double *r, double dt)
+{
+    int moving = m->built && dt > 0 && n == m->n;
+    if (!m->built || n != m->n || m->eps_acc > m->eps_retri || m->eps_retri == 0 || (moving && wrapped(m, n, x))) {
+        if (pn_model_rebuild(m, n, x, r)) return -1;
+    }
+    int np = m->net.npore;
+    double t0 = wtime();
+    if (moving) {
+        /* previous positions continuous with x (periodic unwrapping: the
+         * topology now follows x) */
+        for (int i = 0; i < 3 * n; i++) {
+            const int a = i % 3;
+            double xp = m->x_prev[i];
+            if (m->dom.periodic[a]) {
+                const double L = m->dom.hi[a] - m->dom.lo[a];
+                xp -= L * nearbyint((xp - x[i]) / L);
+            }
+            m->x_cont[i] = xp;
+        }
+        /* rate of change of the pore volumes on the current topology, from
+         * the positions at the start and the end of the step (4.8) */
+        pn_pore_volumes(&m->dom, &m->tri, &m->net, m->x_cont, m->vol_prev);
+        pn_pore_volumes(&m->dom, &m->tri, &m->net, x, m->vol);
+        double emax = 0;
+        for (int i = 0; i < np; i++) {
+            m->dvdt[i] = (m->vol[i] - m->vol_prev[i]) / dt;
+            if (m->vol_prev[i] > 0) emax = fmax(emax, fabs(m->vol[i] - m->vol_prev[i]) / m->vol_prev[i]);
+        }
+        m->eps_acc += emax;
+    }
+    double t1 = wtime();
+    int rc = pn_solve(m->sol, &m->dom, &m->net, moving ? m->dvdt : NULL, m->p);
+    double t2 = wtime();
+    if (rc) {
+        snprintf(m->err, sizeof m->err, "PCG did not reach porenet.pcg_tol = %g in %d iterations", m->pcg_tol,
+                 pn_solver_iterations(m->sol));
+        return -1;
+    }
+    pn_forces(&m->dom, &m->tri, &m->net, m->p, n, m->f, m->fp, m->fv);
+    m->t_vol += t1 - t0;
+    m->t_solve += t2 - t1;
+    m->t_force += wtime() - t2;
+    memcpy(m->x_prev, x, 3 * (size_t)n * sizeof *x);
+    m->n_steps++;
+    return 0;
+}
+
+double pn_model_permeability(const pn_model_t *m, int a)
+{
+    const pn_domain_t *d = &m->dom;
+    if (!m->built) return NAN;
+    if (d->periodic[a]) {
+        if (d->grad[a] == 0) return NAN;
+        double U[3];
+        pn_mean_velocity(d, &m->net, m->p, U);
+        return -m->prm.mu * U[a] / d->grad[a];
+    }
+    int flo = 2 * a, fhi = 2 * a + 1;
+    if (d->bc[flo] != PN_BC_PRESSURE || d->bc[fhi] != PN_BC_PRESSURE) return NAN;
+    double dP = d->bc_value[flo] - d->bc_value[fhi];
+    if (dP == 0) return NAN;
+    double q[6];
+    pn_face_fluxes(d, &m->net, m->p, q);
+    double L = d->hi[a] - d->lo[a], S = 1;
+    for (int b = 0; b < 3; b++)
+        if (b != a) S *= d->hi[b] - d->lo[b];
+    /* mean of inlet and outlet (equal to round-off with the direct solver) */
+    double Q = 0.5 * (q[flo] - q[fhi]);
+    return m->prm.mu * Q * L / (dP * S);
+}
+
+int pn_model_validity(const pn_model_t *m, const double *r, char *buf, size_t nbuf, double *re, double *size_ratio,
+                      double *porosity)
+{
+    int nw = 0;
+    size_t used = 0;
+    buf[0] = 0;
+    double rmean = 0, rmin = INFINITY;
+    for (int i = 0; i < m->n; i++) rmean += r[i], rmin = fmin(rmin, r[i]);
+    rmean /= m->n;
+    double umax = 0;
+    for (int f = 0; f < m->net.nthroat; f++) {
+        double q = m->net.k[f] * pn_throat_dp(&m->dom, &m->net, m->p, f) / m->net.wt[f];
+        umax = fmax(umax, fabs(q) / m->net.area[f]);
+    }
+    double vv = 0, vt = 0;
+    for (int i = 0; i < m->net.npore; i++) vv += m->net.vvoid[i], vt += m->net.vol[i];
+    *re = m->rho_f * umax * 2 * rmean / m->prm.mu;
+    *size_ratio = rmin / rmean;
+    *porosity = vt > 0 ? vv / vt : NAN;
+#define ADD(...)                                                                   \
+    do {                                                                           \
+        if (used < nbuf) used += (size_t)snprintf(buf + used, nbuf - used, __VA_ARGS__); \
+        nw++;                                                                      \
+    } while (0)
+    /* creeping flow in the throats (Stokes assumption, thesis §1.1) */
+    if (*re > 1) ADD("pore Reynolds number %.3g > 1: inertia in the throats, the resolved fluid is needed\n", *re);
+    /* per-particle forces: error < 10 % for d/D > 0.2, factor 2 below 0.1 (thesis fig. 3.15) */
+    if (*size_ratio < 0.2)
+        ADD("smallest/mean radius %.3g < 0.2: forces on the small particles are underestimated (up to 2x below "
+            "0.1)\n",
+            *size_ratio);
+    /* dense packings (n ~ 0.3-0.5): pores are well defined */
+    if (*porosity > 0.5 || *porosity < 0.25)
+        ADD("porosity %.3g outside 0.25-0.5: the pore network is meant for dense packings\n", *porosity);
+#undef ADD
+    return nw;
+}
