@@ -113,6 +113,10 @@ int main(int argc, char **argv)
     msg("  fraction of the fluid step  %8.1f %%  (target <= 25 %%)\n", 100 * w[3] / t_fluid);
     msg("  node entries per sphere     %8.0f (%.1f MB on all ranks), %.1f %% in runs shared with a neighbour\n",
         nodes / count, nodes * (8 + 40.0 / 8) / 1e6, 100 * shared / nodes);
+    /* one line for bench/run.sh */
+    msg("ibm_result N=%d spheres=%d dpd=%g ranks=%d viscous=%s fluid_step=%.4f ibm=%.4f alpha=%.4f forcing=%.4f "
+        "integrals=%.4f fraction=%.3f\n",
+        N, count, dpd, g->nranks, implicit ? "implicit" : "explicit", t_fluid, w[3], w[0], w[1], w[2], w[3] / t_fluid);
     ibm_free(ibm);
     free(s);
     fluid_free(f);
