@@ -72,12 +72,45 @@ static void test_grid_crossing(void **state)
     it_free(&tc);
 }
 
+/* A prescribed sphere following a velocity history (CSV, linear in time)
+ * is where the integral of that history puts it: with u = (t, t/2, 0) the
+ * centre is x0 + (t²/2, t²/4) exactly (the trapezoidal rule of each stage is
+ * exact for a linear velocity), and its velocity is the history's.  2-D.
+ * (Each rank writes and reads its own copy of the file.) */
+static void test_velocity_history(void **state)
+{
+    (void)state;
+    char path[] = "/tmp/ibmdem_history_XXXXXX";
+    int fd = mkstemp(path);
+    FILE *f = fdopen(fd, "w");
+    fprintf(f, "t,u,v,oz\n0,0,0,0\n1,1,0.5,2\n2,2,1,4\n");
+    fclose(f);
+    MPI_Barrier(MPI_COMM_WORLD);
+    char text[1024];
+    snprintf(text, sizeof text,
+             "[domain]\ngeometry = 2d\nnx = 32\nny = 32\nlength = 4 4 1\n[fluid]\nnu = 0.1\ndt = 0.01\n"
+             "[ibm]\nsphere1 = prescribed center 1 1 0 radius 0.3 history %s\n",
+             path);
+    it_case_t tc = it_from_case(text);
+    for (int s = 0; s < 150; s++) fluid_step(tc.f, 0.01);
+    const ibm_sphere_t *sp = &tc.ibm->s[0];
+    double t = tc.f->time;
+    double ex = fabs(sp->x[0] - (1 + t * t / 2)), ey = fabs(sp->x[1] - (1 + t * t / 4));
+    double eu = fabs(sp->u[0] - t) + fabs(sp->u[1] - t / 2) + fabs(sp->omega[2] - 2 * t);
+    print_message("  t = %.2f: centre error %.1e %.1e, velocity error %.1e\n", t, ex, ey, eu);
+    assert_true(ex < 1e-12 && ey < 1e-12 && eu < 1e-12);
+    it_free(&tc);
+    MPI_Barrier(MPI_COMM_WORLD);
+    remove(path); /* each rank wrote its own file */
+}
+
 int main(int argc, char **argv)
 {
     test_mpi_init(&argc, &argv);
     modules_register_keys();
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_grid_crossing),
+        cmocka_unit_test(test_velocity_history),
     };
     TEST_MPI_RUN("ibm_crossing", tests);
 }
