@@ -76,7 +76,8 @@ void fluid_init_from_config(fluid_t *f, cfg_t *cfg);
 void fluid_project(fluid_t *f);
 /* From a stage hook: project the current u* as the end of the stage does
  * (the pressure gets the correction too), e.g. between forcing iterations;
- * the stage's own projection still follows the hook.  Fills the ghosts. */
+ * the stage's own projection still follows the hook.  Fills the ghosts of
+ * u* first (boundary conditions, halos) and after. */
 void fluid_stage_project(fluid_t *f, double dt_stage);
 void fluid_free(fluid_t *f);
 

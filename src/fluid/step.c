@@ -133,7 +133,11 @@ void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, doubl
     fluid_apply_bc(f);
 }
 
-void fluid_stage_project(fluid_t *f, double dt_stage) { fluid_project_stage(f, dt_stage, 1, NULL); }
+void fluid_stage_project(fluid_t *f, double dt_stage)
+{
+    fluid_apply_bc(f); /* the caller changed u* (forcing): its ghosts enter D u* */
+    fluid_project_stage(f, dt_stage, 1, NULL);
+}
 
 void fluid_project(fluid_t *f)
 {
