@@ -74,6 +74,7 @@ struct poisson {
      * of b and returns x of zero weighted mean, so poisson_solve need not
      * copy b (otherwise poisson_solve does it around the back-end) */
     int backend_handles_singular;
+    double *rhs_scratch;  /* compatible copy of b for singular solves, allocated on first use */
     /* statistics of the last solve */
     double last_residual; /* relative residual ||b − A x|| / ||b|| (measured), or −1 when the
                            * method does not measure it (the direct solver: round-off by

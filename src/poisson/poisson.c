@@ -127,6 +127,7 @@ void poisson_free(poisson_t *p)
     if (!p) return;
     if (p->backend && p->impl) p->backend->destroy(p->impl);
     free(p->cw);
+    free(p->rhs_scratch);
     free(p);
 }
 
@@ -256,19 +257,18 @@ int poisson_solve(poisson_t *p, double lambda, const double *b, double *x)
 {
     if (!p->backend) die("poisson_solve: operator created without a solver (poisson_create_operator)");
     const double *rhs = b;
-    double *tmp = NULL;
     int sing = p->singular && lambda == 0.0 && !p->backend_handles_singular;
     if (sing) {
-        /* Remove the incompatible part (weighted mean) of b. */
+        /* Remove the incompatible part (weighted mean) of b, in a scratch
+         * field kept with the solver (this runs every projection). */
         double m = poisson_weighted_mean(p, b);
-        tmp = field_alloc(p->g);
-        field_copy(p->g, tmp, b);
-        poisson_add_constant(p, tmp, -m);
-        rhs = tmp;
+        if (!p->rhs_scratch) p->rhs_scratch = field_alloc(p->g);
+        field_copy(p->g, p->rhs_scratch, b);
+        poisson_add_constant(p, p->rhs_scratch, -m);
+        rhs = p->rhs_scratch;
     }
     int rc = p->backend->solve(p, p->impl, lambda, rhs, x);
     if (sing) poisson_add_constant(p, x, -poisson_weighted_mean(p, x));
-    free(tmp);
     return rc;
 }
 
