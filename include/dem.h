@@ -102,6 +102,22 @@ double *dem_ext_torque(dem_t *d);
 /* Total contact force of each particle (pairs and walls) at the last step. */
 const double *dem_contact_forces(const dem_t *d);
 
+/* Brenner lubrication (lubrication.c; [lubrication] in a case file):
+ * viscosity η_f (≤ 0: off), η_e/R, Δ_lub/R, subtract the force at Δ_lub,
+ * also against walls.  Call before the first step. */
+void dem_set_lubrication(dem_t *d, double viscosity, double roughness, double range, int subtract, int walls);
+void dem_lubrication_register_keys(void);
+/* Lubrication force on each particle in the last step (impulse / dt), 3n;
+ * pairs and walls that exchanged a lubrication impulse in the last step. */
+const double *dem_lubrication_forces(const dem_t *d);
+long dem_lubrication_active(const dem_t *d);
+/* A function called after every DEM step (NULL: none), e.g. to record the
+ * motion at the resolution of the sub-steps. */
+void dem_set_step_observer(dem_t *d, void (*fn)(dem_t *d, void *ctx), void *ctx);
+/* Velocity of particle i at the end of the current step (inside an observer
+ * the stored velocities are half-step values). */
+void dem_full_velocity(const dem_t *d, int i, double vel[3]);
+
 /* Bytes allocated by the DEM per particle (particles, lists, cells, walls). */
 double dem_memory_per_particle(const dem_t *d);
 

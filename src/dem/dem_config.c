@@ -532,6 +532,7 @@ dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
     if (d->nthreads > 1) cfg_fail(cfg, "dem", "threads", "this build has no OpenMP (compile src/dem with -fopenmp)");
 #endif
     d->hist_update = 1;
+    dem_lubrication_config(d, cfg);
     config_walls(d, cfg);
     const int src = cfg_enum(cfg, "particles", "source");
     if (src == 2 && cfg_enum(cfg, "bed", "type") != 0)
