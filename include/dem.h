@@ -85,6 +85,9 @@ double dem_time(const dem_t *d);
 double dem_contact_time(const dem_t *d);
 void dem_set_time(dem_t *d, double t);
 void dem_set_gravity(dem_t *d, const double g[3]);
+void dem_get_gravity(const dem_t *d, double g[3]);
+/* The dry restitution coefficient e_dry (ε_max) of the contact law (0 if given by stiffness). */
+double dem_dry_restitution(const dem_t *d);
 
 /* Particle arrays (3-vectors are stored x,y,z per particle). */
 int dem_count(const dem_t *d);

@@ -19,4 +19,5 @@ void modules_register_keys(void)
     sim_register_keys();
     dem_register_keys();
     dem_lubrication_register_keys();
+    sim_coupling_register_keys();
 }

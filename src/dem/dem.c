@@ -511,6 +511,8 @@ double dem_dt(const dem_t *d) { return d->dt; }
 double dem_time(const dem_t *d) { return d->time; }
 double dem_contact_time(const dem_t *d) { return d->tc; }
 void dem_set_time(dem_t *d, double t) { d->time = t; }
+void dem_get_gravity(const dem_t *d, double g[3]) { memcpy(g, d->gravity, 3 * sizeof(double)); }
+double dem_dry_restitution(const dem_t *d) { return d->cp.restitution; }
 void dem_set_gravity(dem_t *d, const double g[3])
 {
     dem_sync_velocities(d);

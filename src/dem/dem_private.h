@@ -109,6 +109,7 @@ struct dem {
     double lo[3], hi[3], L[3];
     int periodic[3];
     int any_periodic;
+    int axisymmetric;    /* the fluid is axisymmetric: spheres on the y axis (x = z = 0) */
 
     /* walls */
     int nwall;
