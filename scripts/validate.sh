@@ -119,6 +119,10 @@ IBM_FULL=1 $MPIRUN -np 2 "$BUILD/tests/test_ibm_stokes" || fail "ibm Stokes drag
 section "ibm: settling sphere, 3-D, D/dx = 16"
 IBM_FULL3D=1 IBM_TESTS=test_settling_3d $MPIRUN -np 2 "$BUILD/tests/test_ibm_settling" || fail "ibm settling 3-D"
 
+# --- coupling: the bouncing sphere at full size (scripts/validate_coupling.sh)
+section "coupling: bouncing sphere (Izard Fig. 3.3), phases, no lubrication, D/dx = 8..40, 3-D"
+BUILD=$BUILD OUT=$OUT bash scripts/validate_coupling.sh || fail "coupling bouncing sphere"
+
 # (further modules: add sections here)
 
 echo
