@@ -129,6 +129,30 @@ MARK = {"diamond": "D", "asterisk": "*", "square": "s", "v": "v", "star": "*", "
 COLOURS = {2.5: "tab:green", 8: "tab:blue", 16: "tab:orange", 32: "tab:red", 64: "tab:purple", 128: "tab:brown"}
 
 
+def plot_runs(ax, rows, xkey, ykey, colours):
+    """Measured points: one line per density ratio, filled with lubrication, open without."""
+    for ratio in sorted({r["ratio"] for r in rows}):
+        for lub, mfc in (("brenner", None), ("none", "none")):
+            pts = [r for r in rows if r["ratio"] == ratio and r["lubrication"] == lub]
+            if not pts: continue
+            col = colours.get(ratio, "k")
+            ax.plot([p[xkey] for p in pts], [p[ykey] for p in pts], "o-" if lub == "brenner" else "o:",
+                    color=col, mfc=mfc or col, ms=5, lw=0.8,
+                    label=rf"$\rho_p/\rho$ = {ratio:g}, " + ("lubrication" if lub == "brenner" else "no lubrication"))
+
+
+def finish(fig, ax, xlim, xlabel, ylabel, title, path):
+    ax.set_xscale("log")
+    ax.set_xlim(*xlim)
+    ax.set_ylim(-0.03, 1.05)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
 def plot_wall(wall, path):
     import matplotlib
     matplotlib.use("Agg")
@@ -154,23 +178,9 @@ def plot_wall(wall, path):
     ax.axvspan(5, 20, ymin=0, ymax=0.04, color="tab:olive", alpha=0.6, label="experimental $St_c$ 5–20")
     ax.errorbar([60], [0.6], xerr=[[10], [10]], yerr=[[0.05], [0.05]], fmt="P", color="tab:olive", ms=9,
                 label=r"Gondret/Joseph $\varepsilon/\varepsilon_{max}\approx0.6$ at $St\approx60$")
-    for ratio in sorted({r["ratio"] for r in wall}):
-        for lub, mfc in (("brenner", None), ("none", "none")):
-            pts = [r for r in wall if r["ratio"] == ratio and r["lubrication"] == lub]
-            if not pts: continue
-            col = COLOURS.get(ratio, "k")
-            ax.plot([p["St"] for p in pts], [p["epsilon_over_max"] for p in pts], "o-" if lub == "brenner" else "o:",
-                    color=col, mfc=mfc or col, ms=5, lw=0.8,
-                    label=rf"$\rho_p/\rho$ = {ratio:g}, " + ("lubrication" if lub == "brenner" else "no lubrication"))
-    ax.set_xscale("log")
-    ax.set_xlim(0.5, 3000)
-    ax.set_ylim(-0.03, 1.05)
-    ax.set_xlabel(r"$St = (\rho_p+\rho/2) V_T D / 9\eta_f$")
-    ax.set_ylabel(r"$\varepsilon/\varepsilon_{max}$")
-    ax.set_title("Sphere bouncing on a wall (axisymmetric, D/Δx = 10, η_e/R = 2e-4)", fontsize=10)
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    plot_runs(ax, wall, "St", "epsilon_over_max", COLOURS)
+    finish(fig, ax, (0.5, 3000), r"$St = (\rho_p+\rho/2) V_T D / 9\eta_f$", r"$\varepsilon/\varepsilon_{max}$",
+           "Sphere bouncing on a wall (axisymmetric, D/Δx = 10, η_e/R = 2e-4)", path)
 
 
 def plot_binary(pair, path):
@@ -193,23 +203,9 @@ def plot_binary(pair, path):
     ax.errorbar([135], [0.7], yerr=[[0.1], [0.1]], fmt="none", ecolor="tab:olive", elinewidth=3, capsize=5,
                 label=r"Yang & Hunt: $\varepsilon_B\in[0.6,0.8]$ at $St_B\approx135$")
     ax.axvspan(5, 20, ymin=0, ymax=0.04, color="tab:olive", alpha=0.6, label="experimental $St_c$ 5–20")
-    for ratio in sorted({r["ratio"] for r in pair}):
-        for lub, mfc in (("brenner", None), ("none", "none")):
-            pts = [r for r in pair if r["ratio"] == ratio and r["lubrication"] == lub]
-            if not pts: continue
-            col = {8: "tab:blue", 2.3: "tab:green", 90: "tab:red"}.get(ratio, "k")
-            ax.plot([p["St_B"] for p in pts], [p["epsilon_B"] for p in pts], "o-" if lub == "brenner" else "o:",
-                    color=col, mfc=mfc or col, ms=5, lw=0.8,
-                    label=rf"$\rho_p/\rho$ = {ratio:g}, " + ("lubrication" if lub == "brenner" else "no lubrication"))
-    ax.set_xscale("log")
-    ax.set_xlim(1, 3e4)
-    ax.set_ylim(-0.03, 1.05)
-    ax.set_xlabel(r"$St_B = \rho_p U_i D / 9\eta_f$")
-    ax.set_ylabel(r"$\varepsilon_B$")
-    ax.set_title("Binary collision on the axis (D/Δx = 20, η_e/R = 2e-4)", fontsize=10)
-    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    plot_runs(ax, pair, "St_B", "epsilon_B", {8: "tab:blue", 2.3: "tab:green", 90: "tab:red"})
+    finish(fig, ax, (1, 3e4), r"$St_B = \rho_p U_i D / 9\eta_f$", r"$\varepsilon_B$",
+           "Binary collision on the axis (D/Δx = 20, η_e/R = 2e-4)", path)
 
 
 def check(out, wall, pair, missing):
