@@ -10,7 +10,7 @@
 # usage: scripts/restitution.sh [OUT=build/restitution] [full|coarse]
 set -e
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-OUT=${1:-$ROOT/build/restitution}
+OUT=$(realpath -m "${1:-$ROOT/build/restitution}")
 MODE=${2:-full}
 JOBS=${JOBS:-$(nproc)}
 PY=/usr/bin/python3
