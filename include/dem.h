@@ -114,6 +114,9 @@ void dem_lubrication_register_keys(void);
  * pairs and walls that exchanged a lubrication impulse in the last step. */
 const double *dem_lubrication_forces(const dem_t *d);
 long dem_lubrication_active(const dem_t *d);
+/* Time until the first particle–particle or particle–wall contact at the
+ * current velocities (0: a contact exists; INFINITY: nothing approaches). */
+double dem_time_to_contact(const dem_t *d);
 /* A function called after every DEM step (NULL: none), e.g. to record the
  * motion at the resolution of the sub-steps. */
 void dem_set_step_observer(dem_t *d, void (*fn)(dem_t *d, void *ctx), void *ctx);

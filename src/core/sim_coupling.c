@@ -29,6 +29,9 @@ static const cfg_key_t coupling_keys[] = {
     {"coupling", "stop_after_rebound", CFG_BOOL, "false", 1, 0, NULL,
      "restitution: stop the run once the bounce is measured (the particle moves towards the wall again, touches "
      "it a second time, rests on it, or stopped before touching it)"},
+    {"coupling", "align_contacts", CFG_BOOL, "false", 1, 0, NULL,
+     "end a fluid step where a contact is predicted to start (steps not shorter than t_c/4), so that "
+     "collisions start at the beginning of a fluid step"},
     {"coupling", "restitution_axis", CFG_VEC3, NULL, -1e300, 1e300, NULL,
      "wall: direction from the particle towards the wall (default: along gravity)"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
@@ -48,6 +51,7 @@ typedef struct {
     restitution_t rest;
     dem_status_t status;
     int stop_after;      /* [coupling] stop_after_rebound */
+    int align;           /* [coupling] align_contacts */
     double wall_dem;     /* wall time in the DEM */
     long substeps;       /* DEM sub-steps done */
 } coupling_part_t;
@@ -90,10 +94,18 @@ static void setup(coupling_part_t *cp)
     }
 }
 
+/* align_contacts: the step ends where the next contact is predicted to
+ * start (at the current velocities), unless that is less than t_c/4 away; the
+ * lubrication slows the approach, so a few steps may be cut before the contact. */
 static double part_stable_dt(void *ctx)
 {
-    setup(ctx);
-    return INFINITY;
+    coupling_part_t *cp = ctx;
+    setup(cp);
+    if (!cp->ibm || !cp->align) return INFINITY;
+    const double t = dem_time_to_contact(cp->d);
+    if (t <= 0) return INFINITY; /* in contact: the fluid stays frozen over a whole step */
+    const double tmin = 0.25 * dem_contact_time(cp->d);
+    return t > tmin ? t : INFINITY; /* it starts early in the next step anyway */
 }
 
 static void part_advance(void *ctx, double dt)
@@ -236,6 +248,7 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
         mu = cfg_double(cfg, "lubrication", "viscosity");
     /* density, diameter and ε_max of the tracked particle: at setup */
     restitution_init(&cp->rest, (restitution_mode_t)mode, axis, cp->rho_f, mu, 0.0, 0.0, 0.0);
+    cp->align = cfg_bool(cfg, "coupling", "align_contacts");
     cp->stop_after = mode != RESTITUTION_OFF && cfg_bool(cfg, "coupling", "stop_after_rebound");
     sim_part_t part = {
         .name = "coupling",
