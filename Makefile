@@ -3,6 +3,7 @@
 #   make test       install missing Debian packages, build, run the test suite (1 and 2 ranks)
 #   make demo       install, build, run the built-in demo case and plot it
 #   make validate   full-size validation cases (long)
+#   make restitution  restitution sweeps of issue 5 (wall and binary; ~20 min on 2 cores)
 #   make bench      benchmarks, results appended to docs/performance.md
 #   make deps       install missing Debian packages (apt-get)
 #   SANITIZE=1      build with AddressSanitizer + UBSan into build-san/
@@ -78,6 +79,12 @@ validate: deps
 bench: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bash bench/run.sh
+
+# restitution curves of the bouncing sphere and the binary collision (issue 5): the sweep in
+# parallel on the available cores, build/restitution/{restitution,binary}.{csv,png}, target checks
+restitution: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bash scripts/restitution.sh $(BUILD)/restitution full
 
 clean:
 	rm -rf build build-san
