@@ -55,7 +55,7 @@ typedef struct {
     double VC_onset;     /* approach speed at the last sub-step before the contact starts */
     double VR_release;   /* rebound speed when the contact ends (sub-step) */
     double t_contact, t_release;
-    double lub_impulse;  /* lubrication impulse on the particle along the axis in the last fluid step */
+    double lub_impulse;  /* lubrication impulse on particle 0 against its approach direction, last fluid step */
 } restitution_t;
 
 /* axis: wall mode: unit vector from the particle towards the wall. */

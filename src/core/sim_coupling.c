@@ -207,9 +207,11 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
 #undef KEY
 }
 
-/* The bounce is measured: moving towards the wall again after the
- * rebound, a second contact, resting in contact for 40 t_c, or at rest
- * before touching (the lubrication stopped it: speed below 1e-3 V_T). */
+/* The bounce is measured: after the rebound, moving towards the wall again
+ * (wall) or separating at less than 0.9 of the largest rebound speed (pair:
+ * the maximum is behind), a second contact, resting in contact for 40 t_c,
+ * or stopped before touching (the lubrication held it: approach speed below
+ * 1 % of V_T). */
 static int part_done(void *ctx)
 {
     coupling_part_t *cp = ctx;
@@ -217,9 +219,11 @@ static int part_done(void *ctx)
     const restitution_t *r = &cp->rest;
     const double u = restitution_approach_speed(r, cp->d, 0), t = dem_time(cp->d);
     switch (r->phase) {
-    case 0: return r->VT > 0 && fabs(u) < 1e-3 * r->VT && cp->sim->step > 10;
+    case 0: return r->VT > 0 && fabs(u) < 1e-2 * r->VT && cp->sim->step > 10;
     case 1: return t - r->t_contact > 40 * dem_contact_time(cp->d);
-    case 2: return u > 0 && r->VR > 0;
+    case 2:
+        if (r->mode == RESTITUTION_PAIR) return r->VR > 0 && -u < 0.9 * r->VR;
+        return u > 0 && r->VR > 0;
     default: return 1;
     }
 }

@@ -96,9 +96,22 @@ void restitution_substep(restitution_t *r, dem_t *d)
     const int c = in_contact(r, d);
     const int i = index_of(d, 0);
     if (i >= 0) {
+        /* impulse on particle 0 against its approach direction (the wall axis, or the line
+         * from particle 0 to particle 1): positive when it pushes the particle back */
+        double dir[3] = {r->axis[0], r->axis[1], r->axis[2]};
+        const int j = r->mode == RESTITUTION_PAIR ? index_of(d, 1) : -1;
+        if (j >= 0) {
+            const double *x = dem_positions(d);
+            double len = 0;
+            for (int a = 0; a < 3; a++) {
+                dir[a] = x[3 * j + a] - x[3 * i + a];
+                len += dir[a] * dir[a];
+            }
+            len = sqrt(len);
+            for (int a = 0; a < 3; a++) dir[a] /= len;
+        }
         const double *fl = dem_lubrication_forces(d) + 3 * i;
-        /* impulse along the approach direction: positive when it pushes the particle back */
-        r->lub_impulse -= dem_dt(d) * (fl[0] * r->axis[0] + fl[1] * r->axis[1] + fl[2] * r->axis[2]);
+        r->lub_impulse -= dem_dt(d) * (fl[0] * dir[0] + fl[1] * dir[1] + fl[2] * dir[2]);
     }
     switch (r->phase) {
     case 0:
