@@ -92,32 +92,79 @@ int main(int argc, char **argv)
     fluid_step(f, dt); /* warm-up: FFTW plans, first touches */
     double t_fluid = time_steps(f, steps, dt);
 
-    ibm_params_t ip = ibm_default_params();
-    ip.gravity[1] = -1.0;
-    ibm_t *ibm = ibm_create(f, &ip, s, count);
-    fluid_step(f, dt);
-    double w0 = ibm->wall_alpha + ibm->wall_forcing + ibm->wall_integrals;
-    double a0 = ibm->wall_alpha, f0 = ibm->wall_forcing, i0 = ibm->wall_integrals;
-    double t_both = time_steps(f, steps, dt);
-    double w[4] = {(ibm->wall_alpha - a0) / steps, (ibm->wall_forcing - f0) / steps,
-                   (ibm->wall_integrals - i0) / steps, 0};
-    w[3] = (ibm->wall_alpha + ibm->wall_forcing + ibm->wall_integrals - w0) / steps;
-    MPI_Allreduce(MPI_IN_PLACE, w, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
-    double nodes = grid_sum(g, (double)ibm->nodes_forced), shared = grid_sum(g, (double)ibm->nodes_shared);
     msg("bench_ibm: %d^3 cells, %d ranks, %s viscous term; %d spheres at D/dx = %g (solid fraction %.3f)\n", N,
         g->nranks, implicit ? "Crank-Nicolson" : "explicit", count, dpd, phi);
     msg("  fluid step alone            %8.4f s\n", t_fluid);
-    msg("  fluid step with the spheres %8.4f s (difference %.4f s)\n", t_both, t_both - t_fluid);
-    msg("  immersed boundary per step  %8.4f s: alpha %.4f, forcing %.4f, integrals + update %.4f\n", w[3], w[0], w[1],
-        w[2]);
-    msg("  fraction of the fluid step  %8.1f %%  (target <= 25 %%)\n", 100 * w[3] / t_fluid);
-    msg("  node entries per sphere     %8.0f (%.1f MB on all ranks), %.1f %% in runs shared with a neighbour\n",
-        nodes / count, nodes * (8 + 40.0 / 8) / 1e6, 100 * shared / nodes);
-    /* one line for bench/run.sh */
-    msg("ibm_result N=%d spheres=%d dpd=%g ranks=%d viscous=%s fluid_step=%.4f ibm=%.4f alpha=%.4f forcing=%.4f "
-        "integrals=%.4f fraction=%.3f\n",
-        N, count, dpd, g->nranks, implicit ? "implicit" : "explicit", t_fluid, w[3], w[0], w[1], w[2], w[3] / t_fluid);
-    ibm_free(ibm);
+    /* the three variants, each timed after one warm-up step with its spheres */
+    static const struct {
+        const char *name, *what;
+        ibm_kind_t kind;
+        int move;
+    } variant[] = {
+        {"external_moving", "external spheres (DEM-coupled) moved by 0.01 dx between steps, alpha rebuilt every step",
+         IBM_EXTERNAL, 1},
+        {"external_rest", "external spheres at rest (alpha built once)", IBM_EXTERNAL, 0},
+        {"free", "free spheres (rho_p/rho = 2 under gravity, alpha rebuilt at every stage)", IBM_FREE, 0},
+    };
+    for (int v = 0; v < 3; v++) {
+        for (int p = 0; p < count; p++) {
+            s[p].kind = variant[v].kind;
+            memset(s[p].u, 0, sizeof s[p].u);
+            memset(s[p].omega, 0, sizeof s[p].omega);
+        }
+        ibm_params_t ip = ibm_default_params();
+        ip.gravity[1] = -1.0;
+        ibm_t *ibm = ibm_create(f, &ip, s, count);
+        /* external spheres: a small displacement between steps along a fixed
+         * random direction per sphere, as the DEM would make, with the
+         * matching velocity */
+        double *dir = xcalloc(3 * (size_t)count, sizeof *dir);
+        for (int p = 0; p < count; p++) {
+            for (int d = 0; d < 3; d++) dir[3 * p + d] = urand(&seed) - 0.5;
+            double nrm = sqrt(dir[3 * p] * dir[3 * p] + dir[3 * p + 1] * dir[3 * p + 1] + dir[3 * p + 2] * dir[3 * p + 2]);
+            for (int d = 0; d < 3; d++) dir[3 * p + d] *= 0.01 * dx / nrm;
+        }
+        double w0 = 0, a0 = 0, f0 = 0, i0 = 0, t_both = 0;
+        for (int it = 0; it <= steps; it++) { /* step 0: warm-up */
+            if (it == 1) {
+                w0 = ibm->wall_alpha + ibm->wall_forcing + ibm->wall_integrals;
+                a0 = ibm->wall_alpha, f0 = ibm->wall_forcing, i0 = ibm->wall_integrals;
+            }
+            MPI_Barrier(MPI_COMM_WORLD);
+            double t0 = wtime();
+            if (variant[v].move) {
+                for (int p = 0; p < count; p++)
+                    for (int d = 0; d < 3; d++) {
+                        ibm->s[p].x[d] += dir[3 * p + d];
+                        ibm->s[p].u[d] = dir[3 * p + d] / dt;
+                    }
+                ibm_update_geometry(ibm);
+            }
+            fluid_step(f, dt);
+            if (it > 0) t_both += wtime() - t0;
+        }
+        t_both /= steps;
+        MPI_Allreduce(MPI_IN_PLACE, &t_both, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+        double w[4] = {(ibm->wall_alpha - a0) / steps, (ibm->wall_forcing - f0) / steps,
+                       (ibm->wall_integrals - i0) / steps, 0};
+        w[3] = (ibm->wall_alpha + ibm->wall_forcing + ibm->wall_integrals - w0) / steps;
+        MPI_Allreduce(MPI_IN_PLACE, w, 4, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+        double nodes = grid_sum(g, (double)ibm->nodes_forced), shared = grid_sum(g, (double)ibm->nodes_shared);
+        msg("  %s:\n", variant[v].what);
+        msg("    fluid step with the spheres %8.4f s (difference %.4f s)\n", t_both, t_both - t_fluid);
+        msg("    immersed boundary per step  %8.4f s: alpha %.4f, forcing %.4f, integrals + update %.4f\n", w[3],
+            w[0], w[1], w[2]);
+        msg("    fraction of the fluid step  %8.1f %%  (target <= 25 %%)\n", 100 * w[3] / t_fluid);
+        msg("    node entries per sphere     %8.0f, %.1f %% in runs shared with a neighbour\n", nodes / count,
+            100 * shared / nodes);
+        /* one line per variant for bench/run.sh */
+        msg("ibm_result case=%s N=%d spheres=%d dpd=%g ranks=%d viscous=%s fluid_step=%.4f with_ibm=%.4f ibm=%.4f "
+            "alpha=%.4f forcing=%.4f integrals=%.4f fraction=%.3f\n",
+            variant[v].name, N, count, dpd, g->nranks, implicit ? "implicit" : "explicit", t_fluid, t_both, w[3], w[0],
+            w[1], w[2], w[3] / t_fluid);
+        free(dir);
+        ibm_free(ibm);
+    }
     free(s);
     fluid_free(f);
     grid_free(g);
