@@ -221,31 +221,10 @@ typedef struct {
     const ibm_t *ibm;
     ibm_priv_t *q;
     int p;
-    double R, band, retraction;
 } build_ctx_t;
 
-/* Does the segment of nodes (first at offset r0 from sphere p, len nodes
- * along the run direction) come within R_out of a neighbour of p?  The
- * distance is that of the continuous segment, so the answer is never "no"
- * for a node that a neighbour's runs contain: a node in two spheres' runs
- * is in a shared run of both. */
-static int segment_shared(const ibm_t *ibm, int p, const double r0[3], int len, double h)
-{
-    const ibm_priv_t *q = ibm_priv(ibm);
-    int rd = q->rdir;
-    for (int e = q->nb_start[p]; e < q->nb_start[p + 1]; e++) {
-        const struct ibm_neighbour *nb = &q->nb[e];
-        double Rout = ibm->s[nb->o].radius + (ibm_band_halfwidth() - ibm->prm.retraction) * h + 1e-9 * h;
-        double v[3] = {r0[0] - nb->d[0], r0[1] - nb->d[1], r0[2] - nb->d[2]}; /* the first node seen from o */
-        /* closest point of [v, v + (len − 1) step e_rd] to o's centre */
-        double t = -v[rd], tmax = (len - 1) * q->rstep;
-        t = t < 0 ? 0 : (t > tmax ? tmax : t);
-        v[rd] += t;
-        if (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] < Rout * Rout) return 1;
-    }
-    return 0;
-}
-
+/* α of the node at offset r from the centre of a sphere of radius R: the
+ * profile of ibm_alpha(). */
 static inline double alpha_at(double R, double band, double retraction, const double r[3], double h)
 {
     double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
@@ -254,100 +233,152 @@ static inline double alpha_at(double R, double band, double retraction, const do
     double rr = sqrt(r2), d = rr - R + retraction * h;
     if (d >= band * h) return 0.0;
     if (d <= -band * h) return 1.0;
-    double n[3] = {r[0] / rr, r[1] / rr, r[2] / rr};
-    return ibm_alpha(d, n, h);
+    double lam = fabs(r[0] / rr) + fabs(r[1] / rr) + fabs(r[2] / rr);
+    double sigma = 0.065 * (1.0 - lam * lam) + 0.39;
+    return alpha_of_t(d / (sigma * lam * M_SQRT2 * h));
 }
 
+/* Grid line of a run: (component, local x index[, global y index]). */
+static inline int32_t run_line(const grid_t *g, int c, long m0)
+{
+    int il = ibm_node_i(g, m0);
+    if (g->dim == 2) return (int32_t)(c * g->nxl + il);
+    int jw = (int)((m0 - G_IDX(g, il, 0, 0)) / g->sy);
+    return (int32_t)(((long)c * g->nxl + il) * g->n[1] + jw);
+}
+
+/* Record a run of sphere b->p (its α comes later, in storage order). */
 static void add_run(void *ctx, int c, long m0, int len, const double r0[3], double h)
 {
+    (void)h; /* = hcell[c][i] */
     build_ctx_t *b = ctx;
     ibm_priv_t *q = b->q;
     if (q->nruns == q->cap_runs) {
         q->cap_runs = q->cap_runs ? 2 * q->cap_runs : 1024;
-        q->runs = realloc(q->runs, (size_t)q->cap_runs * sizeof *q->runs);
-        if (!q->runs) die_local("immersed boundary: out of memory for %ld runs", q->cap_runs);
+        q->runs_tmp = realloc(q->runs_tmp, (size_t)q->cap_runs * sizeof *q->runs_tmp);
+        if (!q->runs_tmp) die_local("immersed boundary: out of memory for %ld runs", q->cap_runs);
     }
-    while (q->nalpha + len > q->cap_alpha) {
-        q->cap_alpha = q->cap_alpha ? 2 * q->cap_alpha : 16384;
-        q->alpha = realloc(q->alpha, (size_t)q->cap_alpha * sizeof *q->alpha);
-        if (!q->alpha) die_local("immersed boundary: out of memory for %ld node entries", q->cap_alpha);
-    }
-    ibm_run_t *run = &q->runs[q->nruns++];
+    ibm_run_t *run = &q->runs_tmp[q->nruns++];
     memcpy(run->r0, r0, sizeof run->r0);
     run->m0 = (int32_t)m0;
-    run->a0 = (int32_t)q->nalpha;
     run->len = (int16_t)len;
     run->c = (uint8_t)c;
-    run->shared = (uint8_t)segment_shared(b->ibm, b->p, r0, len, h);
-    if (run->shared) q->nshared += len;
-    double r[3] = {r0[0], r0[1], r0[2]};
-    for (int k = 0; k < len; k++, r[q->rdir] += q->rstep)
-        q->alpha[q->nalpha++] = alpha_at(b->R, b->band, b->retraction, r, h);
+    run->p = b->p;
+    run->line = run_line(b->ibm->g, c, m0);
 }
 
-/* Neighbours: pairs closer than the sum of the radii and of both bands in
- * the largest cell, plus a cell; each periodic image of the other sphere
- * that close counts (in a box shorter than twice that distance, more than
- * the nearest one). */
-static void find_neighbours(const ibm_t *ibm)
+/* Sort the generated runs into storage order (bucketed by grid line, each
+ * line's list by m0, ties in generation order) and merge them into the
+ * forced nodes: the runs of a line that overlap or touch become one node
+ * run, each node once; every sphere run gets the index of its first node
+ * (u0). */
+static void sort_and_merge_runs(ibm_t *ibm)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
-    double hmax = g->dy;
-    if (g->dim == 3) hmax = hmax > g->dz ? hmax : g->dz;
-    for (int i = 0; i < g->n[0]; i++) hmax = hmax > g->gdxf[i] ? hmax : g->gdxf[i];
-    double m = 2 * (ibm_band_halfwidth() + 0.5) * hmax;
-    long k = 0;
-    for (int p = 0; p < ibm->n; p++) {
-        q->nb_start[p] = (int)k;
-        for (int o = 0; o < ibm->n; o++) {
-            if (o == p) continue;
-            double lim = ibm->s[p].radius + ibm->s[o].radius + m, dmin[3] = {0, 0, 0};
-            int top[3] = {0, 0, 0}, im[3];
-            for (int d = 0; d < g->dim; d++) {
-                dmin[d] = ibm->s[o].xa[d] - ibm->s[p].xa[d];
-                if (g->periodic[d]) {
-                    dmin[d] -= g->L[d] * round(dmin[d] / g->L[d]);
-                    top[d] = g->L[d] < 2 * lim; /* the next images may be close too */
-                }
+    long st = q->rstride, nlines = (long)g->dim * g->nxl * (g->dim == 3 ? g->n[1] : 1);
+    if (q->nruns > q->cap_next) {
+        q->cap_next = q->cap_runs;
+        free(q->run_next);
+        free(q->runs);
+        q->run_next = xcalloc((size_t)q->cap_next, sizeof *q->run_next);
+        q->runs = xcalloc((size_t)q->cap_next, sizeof *q->runs);
+    }
+    for (long l = 0; l < nlines; l++) q->line_head[l] = -1;
+    for (long ir = q->nruns - 1; ir >= 0; ir--) {
+        const ibm_run_t *run = &q->runs_tmp[ir];
+        int32_t *at = &q->line_head[run->line];
+        while (*at >= 0 && q->runs_tmp[*at].m0 < run->m0) at = &q->run_next[*at];
+        q->run_next[ir] = *at;
+        *at = (int32_t)ir;
+    }
+    long nr = 0;
+    q->n_nruns = 0;
+    q->nnodes = 0;
+    for (long l = 0; l < nlines; l++) {
+        int32_t ir = q->line_head[l];
+        while (ir >= 0) {
+            long ms = q->runs_tmp[ir].m0, me = ms - st, n0 = q->nnodes; /* first and last node */
+            for (; ir >= 0 && q->runs_tmp[ir].m0 <= me + st; ir = q->run_next[ir]) {
+                ibm_run_t *o = &q->runs[nr++];
+                *o = q->runs_tmp[ir];
+                o->u0 = (int32_t)(n0 + (o->m0 - ms) / st);
+                long oe = o->m0 + (o->len - 1) * st;
+                if (oe > me) me = oe;
             }
-            for (im[0] = -top[0]; im[0] <= top[0]; im[0]++)
-                for (im[1] = -top[1]; im[1] <= top[1]; im[1]++)
-                    for (im[2] = -top[2]; im[2] <= top[2]; im[2]++) {
-                        double dd[3], r2 = 0;
-                        for (int d = 0; d < 3; d++) {
-                            dd[d] = dmin[d] + im[d] * g->L[d];
-                            r2 += dd[d] * dd[d];
-                        }
-                        if (r2 >= lim * lim) continue;
-                        if (k == q->nb_cap) {
-                            q->nb_cap = q->nb_cap ? 2 * q->nb_cap : 256;
-                            q->nb = realloc(q->nb, (size_t)q->nb_cap * sizeof *q->nb);
-                        }
-                        q->nb[k].o = o;
-                        memcpy(q->nb[k].d, dd, sizeof dd);
-                        k++;
-                    }
+            if (q->n_nruns == q->cap_nruns) {
+                q->cap_nruns = q->cap_nruns ? 2 * q->cap_nruns : 1024;
+                q->nruns_f = realloc(q->nruns_f, (size_t)q->cap_nruns * sizeof *q->nruns_f);
+                if (!q->nruns_f) die_local("immersed boundary: out of memory for %ld node runs", q->cap_nruns);
+            }
+            ibm_node_run_t *n = &q->nruns_f[q->n_nruns++];
+            n->m0 = (int32_t)ms;
+            n->n0 = (int32_t)n0;
+            n->len = (int32_t)((me - ms) / st + 1);
+            n->c = q->runs[nr - 1].c;
+            q->nnodes += n->len;
         }
     }
-    q->nb_start[ibm->n] = (int)k;
+}
+
+/* α of every run entry, in storage order, and Σ_p α_p at each forced node. */
+static void compute_alpha(ibm_t *ibm)
+{
+    ibm_priv_t *q = ibm_priv(ibm);
+    const grid_t *g = ibm->g;
+    double band = ibm_band_halfwidth(), retraction = ibm->prm.retraction;
+    long n = 0;
+    for (long ir = 0; ir < q->nruns; ir++) n += q->runs[ir].len;
+    if (n > q->cap_alpha) {
+        q->cap_alpha = n + n / 4;
+        free(q->alpha);
+        q->alpha = xcalloc((size_t)q->cap_alpha, sizeof *q->alpha);
+    }
+    if (q->nnodes > q->cap_nodes) {
+        q->cap_nodes = q->nnodes + q->nnodes / 4;
+        free(q->node_asum);
+        free(q->node_target);
+        free(q->node_imp);
+        q->node_asum = xcalloc((size_t)q->cap_nodes, sizeof(double));
+        q->node_target = xcalloc((size_t)q->cap_nodes, sizeof(double));
+        q->node_imp = xcalloc((size_t)q->cap_nodes, sizeof(double));
+    }
+    memset(q->node_asum, 0, (size_t)q->nnodes * sizeof(double));
+    /* node_imp counts the spheres at each node meanwhile */
+    memset(q->node_imp, 0, (size_t)q->nnodes * sizeof(double));
+    q->nalpha = 0;
+    for (long ir = 0; ir < q->nruns; ir++) {
+        ibm_run_t *run = &q->runs[ir];
+        double R = ibm->s[run->p].radius, h = q->hcell[run->c][ibm_node_i(g, run->m0)];
+        double r[3] = {run->r0[0], run->r0[1], run->r0[2]}, *al = q->alpha + q->nalpha;
+        double *A = q->node_asum + run->u0, *cnt = q->node_imp + run->u0;
+        run->a0 = (int32_t)q->nalpha;
+        for (int k = 0; k < run->len; k++, r[q->rdir] += q->rstep) {
+            al[k] = alpha_at(R, band, retraction, r, h);
+            A[k] += al[k];
+            cnt[k] += 1.0;
+        }
+        q->nalpha += run->len;
+    }
+    q->nshared = 0;
+    for (long ir = 0; ir < q->nruns; ir++) {
+        const ibm_run_t *run = &q->runs[ir];
+        const double *cnt = q->node_imp + run->u0;
+        for (int k = 0; k < run->len; k++) q->nshared += cnt[k] > 1.0;
+    }
 }
 
 void ibm_build_nodes(ibm_t *ibm)
 {
     ibm_priv_t *q = ibm_priv(ibm);
-    build_ctx_t b = {.ibm = ibm, .q = q, .band = ibm_band_halfwidth(), .retraction = ibm->prm.retraction};
+    build_ctx_t b = {.ibm = ibm, .q = q};
+    if (alpha_tmax == 0.0) alpha_table_init();
     q->nruns = 0;
-    q->nalpha = 0;
-    q->nshared = 0;
-    find_neighbours(ibm);
-    for (int p = 0; p < ibm->n; p++) {
-        q->start[p] = q->nruns;
-        b.p = p;
-        b.R = ibm->s[p].radius;
-        for (int c = 0; c < ibm->g->dim; c++) for_sphere_segments(ibm, &ibm->s[p], c, add_run, &b);
-    }
-    q->start[ibm->n] = q->nruns;
+    for (b.p = 0; b.p < ibm->n; b.p++)
+        for (int c = 0; c < ibm->g->dim; c++) for_sphere_segments(ibm, &ibm->s[b.p], c, add_run, &b);
+    sort_and_merge_runs(ibm);
+    compute_alpha(ibm);
+    q->built = 1;
     ibm->nodes_forced = q->nalpha;
     ibm->nodes_shared = q->nshared;
 }

@@ -69,99 +69,98 @@ static inline double forcing_beta(double a, double dt, double tau)
     return a * dt / ((1.0 - a) * tau + a * dt);
 }
 
-/* One forcing of the current velocity; adds the impulse ∫ f dV Δt_k of each
- * sphere and its moment to sum[IBM_FIMP..].  A run that no other sphere's
- * band reaches (run->shared = 0, alpha.c) is forced directly; the shared
- * runs go through the dense scratch, where a node takes α = min(1, Σα_p),
- * the α-weighted mean velocity, and each sphere the share α_p/Σα of its
- * impulse. */
-static void force_pass(ibm_t *ibm, double dt)
+/* The forcing works on the merged node lists of alpha.c: each forced node
+ * once, with α = min(1, Σ_p α_p) and the target velocity the α-weighted
+ * mean Ū = Σ_p (α_p/Σα) U_p(r_p) of the rigid-body velocities of the
+ * spheres whose band reaches it; each sphere then takes the share α_p/Σα
+ * of the node's impulse.  (A node of one sphere: Ū = U_p and its whole
+ * impulse, exactly.)  Three passes: targets (set_targets), forcing of the
+ * nodes (force_nodes, streaming over the node runs, as often as there are
+ * forcings), and each sphere's share of the accumulated impulses
+ * (gather_impulses). */
+
+/* Ū at every forced node from the spheres' current velocities, and the
+ * accumulated impulses reset. */
+static void set_targets(ibm_t *ibm)
+{
+    ibm_priv_t *q = ibm_priv(ibm);
+    double step = q->rstep;
+    int rd = q->rdir;
+    memset(q->node_target, 0, (size_t)q->nnodes * sizeof(double));
+    memset(q->node_imp, 0, (size_t)q->nnodes * sizeof(double));
+    for (long ir = 0; ir < q->nruns; ir++) {
+        const ibm_run_t *run = &q->runs[ir];
+        const ibm_sphere_t *s = &ibm->s[run->p];
+        const double *al = q->alpha + run->a0, *A = q->node_asum + run->u0;
+        double *T = q->node_target + run->u0, r[3] = {run->r0[0], run->r0[1], run->r0[2]};
+        for (int k = 0; k < run->len; k++, r[rd] += step)
+            if (al[k] > 0.0) T[k] += al[k] / A[k] * ibm_rigid_velocity(s, run->c, r);
+    }
+}
+
+/* One forcing u ← u + β (Ū − u) of every forced node, the impulse added
+ * to node_imp. */
+static void force_nodes(ibm_t *ibm, double dt)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
-    fluid_t *f = ibm->f;
-    double kappa = ibm->prm.forcing_time, nu = f->prm.nu, step = q->rstep;
+    double kappa = ibm->prm.forcing_time, nu = ibm->f->prm.nu;
     long st = q->rstride;
-    int rd = q->rdir, shared = 0;
-    for (int p = 0; p < ibm->n; p++) {
-        const ibm_sphere_t *s = &ibm->s[p];
-        double *sum = q->sum + (long)p * IBM_NSUM, J[3] = {0, 0, 0}, T[3] = {0, 0, 0};
-        for (long ir = q->start[p]; ir < q->start[p + 1]; ir++) {
-            const ibm_run_t *run = &q->runs[ir];
-            int c = run->c;
-            if (run->shared) {
-                /* Σ α_p and Σ α_p U_p for the shared pass below */
-                double *A = q->asum[c] + run->m0, *B = q->aux[c] + run->m0, r[3] = {run->r0[0], run->r0[1], run->r0[2]};
-                for (int k = 0; k < run->len; k++, r[rd] += step) {
-                    double a = q->alpha[run->a0 + k];
-                    A[k * st] += a;
-                    B[k * st] += a * ibm_rigid_velocity(s, c, r);
-                }
-                shared = 1;
-                continue;
-            }
-            int i = ibm_node_i(g, run->m0);
-            double *u = f->u[c] + run->m0;
-            const double *al = q->alpha + run->a0;
-            double h = q->hcell[c][i], tau = kappa > 0 ? kappa * h * h / nu : 0.0, vol = q->vol[c][i];
-            double r[3] = {run->r0[0], run->r0[1], run->r0[2]}, jr = 0, t[3];
-            for (int k = 0; k < run->len; k++, r[rd] += step) {
-                double imp = forcing_beta(al[k], dt, tau) * (ibm_rigid_velocity(s, c, r) - u[k * st]);
+    for (long ir = 0; ir < q->n_nruns; ir++) {
+        const ibm_node_run_t *nr = &q->nruns_f[ir];
+        double *u = ibm->f->u[nr->c] + nr->m0, *J = q->node_imp + nr->n0;
+        const double *A = q->node_asum + nr->n0, *T = q->node_target + nr->n0;
+        int len = nr->len;
+        if (kappa > 0) {
+            double h = q->hcell[nr->c][ibm_node_i(g, nr->m0)], tau = kappa * h * h / nu;
+            for (int k = 0; k < len; k++) {
+                double imp = forcing_beta(A[k] < 1.0 ? A[k] : 1.0, dt, tau) * (T[k] - u[k * st]);
                 u[k * st] += imp;
-                jr += imp;
-                cross_axis(r, c, imp, t);
-                for (int d = 0; d < 3; d++) T[d] += t[d] * vol;
+                J[k] += imp;
             }
-            J[c] += jr * vol;
-        }
-        for (int d = 0; d < 3; d++) {
-            sum[IBM_FIMP + d] += J[d];
-            sum[IBM_TIMP + d] += T[d];
-        }
-    }
-    if (!shared) return;
-    /* force each shared node once (u ← u + β (U − u)); keep the impulse in
-     * aux and mark the node done by the sign of asum */
-    for (long ir = 0; ir < q->nruns; ir++) {
-        const ibm_run_t *run = &q->runs[ir];
-        if (!run->shared) continue;
-        int c = run->c, i = ibm_node_i(g, run->m0);
-        double h = q->hcell[c][i], tau = kappa > 0 ? kappa * h * h / nu : 0.0;
-        double *A = q->asum[c] + run->m0, *B = q->aux[c] + run->m0, *u = f->u[c] + run->m0;
-        for (int k = 0; k < run->len; k++) {
-            double Ak = A[k * st];
-            if (Ak <= 0.0) continue;
-            double imp = forcing_beta(Ak < 1.0 ? Ak : 1.0, dt, tau) * (B[k * st] / Ak - u[k * st]);
-            u[k * st] += imp;
-            B[k * st] = imp;
-            A[k * st] = -Ak;
-        }
-    }
-    /* each sphere's share α_p/Σα of the impulse, and its moment */
-    for (int p = 0; p < ibm->n; p++) {
-        double *sum = q->sum + (long)p * IBM_NSUM, t[3];
-        for (long ir = q->start[p]; ir < q->start[p + 1]; ir++) {
-            const ibm_run_t *run = &q->runs[ir];
-            if (!run->shared) continue;
-            int c = run->c;
-            double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]};
-            const double *A = q->asum[c] + run->m0, *B = q->aux[c] + run->m0;
-            for (int k = 0; k < run->len; k++, r[rd] += step) {
-                if (A[k * st] >= 0.0) continue; /* α = 0 at the end of a run: not forced */
-                double J = q->alpha[run->a0 + k] / -A[k * st] * B[k * st] * vol;
-                sum[IBM_FIMP + c] += J;
-                cross_axis(r, c, J, t);
-                for (int d = 0; d < 3; d++) sum[IBM_TIMP + d] += t[d];
+        } else if (st == 1) { /* the seed's β = α, unit stride: vectorised */
+            for (int k = 0; k < len; k++) {
+                double imp = (A[k] < 1.0 ? A[k] : 1.0) * (T[k] - u[k]);
+                u[k] += imp;
+                J[k] += imp;
+            }
+        } else {
+            for (int k = 0; k < len; k++) {
+                double imp = (A[k] < 1.0 ? A[k] : 1.0) * (T[k] - u[k * st]);
+                u[k * st] += imp;
+                J[k] += imp;
             }
         }
     }
+}
+
+/* Each sphere's share of the accumulated impulses: ∫ f dV Δt and its
+ * moment into sum[IBM_FIMP..IBM_TIMP+2] (overwritten).  The runs are in
+ * storage order; each sphere's sums are carried from run to run. */
+static void gather_impulses(ibm_t *ibm)
+{
+    const grid_t *g = ibm->g;
+    ibm_priv_t *q = ibm_priv(ibm);
+    double step = q->rstep;
+    int rd = q->rdir;
+    for (int p = 0; p < ibm->n; p++)
+        for (int d = 0; d < 6; d++) q->sum[(long)p * IBM_NSUM + IBM_FIMP + d] = 0.0;
     for (long ir = 0; ir < q->nruns; ir++) {
         const ibm_run_t *run = &q->runs[ir];
-        if (!run->shared) continue;
-        for (int k = 0; k < run->len; k++) {
-            q->asum[run->c][run->m0 + k * st] = 0.0;
-            q->aux[run->c][run->m0 + k * st] = 0.0;
+        int c = run->c;
+        double *sum = q->sum + (long)run->p * IBM_NSUM, t[3];
+        double T[3] = {sum[IBM_TIMP], sum[IBM_TIMP + 1], sum[IBM_TIMP + 2]};
+        const double *al = q->alpha + run->a0, *A = q->node_asum + run->u0, *imp = q->node_imp + run->u0;
+        double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]}, jr = 0;
+        for (int k = 0; k < run->len; k++, r[rd] += step) {
+            if (!(al[k] > 0.0)) continue;
+            double share = al[k] / A[k] * imp[k];
+            jr += share;
+            cross_axis(r, c, share, t);
+            for (int d = 0; d < 3; d++) T[d] += t[d] * vol;
         }
+        sum[IBM_FIMP + c] += jr * vol;
+        for (int d = 0; d < 3; d++) sum[IBM_TIMP + d] = T[d];
     }
 }
 
@@ -173,25 +172,23 @@ void ibm_momentum(ibm_t *ibm, double *sum_all)
     ibm_priv_t *q = ibm_priv(ibm);
     long st = q->rstride;
     int rd = q->rdir;
-    for (int p = 0; p < ibm->n; p++) {
-        double *sum = sum_all + (long)p * IBM_NSUM, I[3] = {0, 0, 0}, Lm[3] = {0, 0, 0}, t[3];
-        for (long ir = q->start[p]; ir < q->start[p + 1]; ir++) {
-            const ibm_run_t *run = &q->runs[ir];
-            int c = run->c;
-            const double *u = ibm->f->u[c] + run->m0, *al = q->alpha + run->a0;
-            double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]}, s = 0;
-            for (int k = 0; k < run->len; k++, r[rd] += q->rstep) {
-                double a = al[k] * u[k * st];
-                s += a;
-                cross_axis(r, c, a * vol, t);
-                for (int d = 0; d < 3; d++) Lm[d] += t[d];
-            }
-            I[c] += s * vol;
+    for (int p = 0; p < ibm->n; p++)
+        for (int d = 0; d < 6; d++) sum_all[(long)p * IBM_NSUM + IBM_MOM + d] = 0.0;
+    for (long ir = 0; ir < q->nruns; ir++) {
+        const ibm_run_t *run = &q->runs[ir];
+        int c = run->c;
+        double *sum = sum_all + (long)run->p * IBM_NSUM, t[3];
+        double Lm[3] = {sum[IBM_ANG], sum[IBM_ANG + 1], sum[IBM_ANG + 2]};
+        const double *u = ibm->f->u[c] + run->m0, *al = q->alpha + run->a0;
+        double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]}, s = 0;
+        for (int k = 0; k < run->len; k++, r[rd] += q->rstep) {
+            double a = al[k] * u[k * st];
+            s += a;
+            cross_axis(r, c, a * vol, t);
+            for (int d = 0; d < 3; d++) Lm[d] += t[d];
         }
-        for (int d = 0; d < 3; d++) {
-            sum[IBM_MOM + d] = I[d];
-            sum[IBM_ANG + d] = Lm[d];
-        }
+        sum[IBM_MOM + c] += s * vol;
+        for (int d = 0; d < 3; d++) sum[IBM_ANG + d] = Lm[d];
     }
 }
 
@@ -224,6 +221,20 @@ void ibm_update_geometry(ibm_t *ibm)
     ibm_rebuild_geometry(ibm);
 }
 
+/* Do all spheres keep their position and velocity over the fluid step
+ * (fixed spheres, and external ones, which the coupling moves between
+ * steps)?  Then the solid fraction and the targets Ū stay as they are over
+ * the three stages, the forcing impulses accumulate at the nodes, and the
+ * hydrodynamic impulse of the step is taken once, at its end: the
+ * momentum difference telescopes, Σ_k (I^k − I^{k−1}) = I^3 − I^0
+ * (docs/theory.md §6b). */
+static int step_frozen(const ibm_t *ibm)
+{
+    for (int p = 0; p < ibm->n; p++)
+        if (ibm->s[p].kind != IBM_FIXED && ibm->s[p].kind != IBM_EXTERNAL) return 0;
+    return 1;
+}
+
 void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
 {
     ibm_t *ibm = ctx;
@@ -233,13 +244,16 @@ void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
         q->t_step = 0.0;
         q->t_stage0 = f->time;
         memset(q->imp_step, 0, (size_t)ibm->n * 6 * sizeof(double));
+        q->frozen = step_frozen(ibm);
     }
-    memset(q->sum, 0, (size_t)ibm->n * IBM_NSUM * sizeof(double));
+    if (stage == 0 || !q->frozen) set_targets(ibm);
     for (int it = 0; it < ibm->prm.forcing_iterations; it++) {
-        force_pass(ibm, dt_stage);
+        force_nodes(ibm, dt_stage);
         fluid_stage_project(f, dt_stage);
     }
-    force_pass(ibm, dt_stage);
+    force_nodes(ibm, dt_stage);
+    /* the impulses of the stage, before the solid fraction moves */
+    if (!q->frozen) gather_impulses(ibm);
     ibm->wall_forcing += wtime() - w0;
 }
 
@@ -263,7 +277,8 @@ static void predict_centre(const ibm_t *ibm, ibm_sphere_t *s, double dt, double 
 {
     double u1[3], w1[3];
     switch (s->kind) {
-    case IBM_FIXED: memcpy(s->xa, s->x, sizeof s->xa); return;
+    case IBM_FIXED:
+    case IBM_EXTERNAL: memcpy(s->xa, s->x, sizeof s->xa); return; /* moved between steps only */
     case IBM_PRESCRIBED:
         ibm_prescribed_velocity(ibm, s, t_end, u1, w1);
         mask_geometry(ibm->g, u1, w1);
@@ -367,6 +382,25 @@ void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx)
     ibm_priv_t *q = ibm_priv(ibm);
     q->t_step += dt_stage;
     double t_end = q->t_stage0 + q->t_step;
+    if (q->frozen) {
+        /* nothing moves within the step: one impulse for the whole step */
+        if (stage < 2) return;
+        double w0 = wtime();
+        gather_impulses(ibm);
+        ibm_momentum(ibm, q->sum);
+        reduce_sums(ibm);
+        for (int p = 0; p < ibm->n; p++) {
+            double J[3], K[3];
+            update_sphere(ibm, p, q->t_step, t_end, J, K);
+            for (int d = 0; d < 3; d++) {
+                ibm->s[p].force[d] = J[d] / q->t_step;
+                ibm->s[p].torque[d] = K[d] / q->t_step;
+            }
+            for (int d = 0; d < 6; d++) q->mom_prev[6 * p + d] = q->sum[(long)p * IBM_NSUM + IBM_MOM + d];
+        }
+        ibm->wall_integrals += wtime() - w0;
+        return;
+    }
     /* move the solid fraction to the predicted centres */
     int moved = 0;
     for (int p = 0; p < ibm->n; p++) {
