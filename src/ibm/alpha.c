@@ -224,7 +224,7 @@ typedef struct {
 } build_ctx_t;
 
 /* α of the node at offset r from the centre of a sphere of radius R: the
- * profile of ibm_alpha(). */
+ * profile of ibm_alpha() (the cell-centre fraction of the snapshots). */
 static inline double alpha_at(double R, double band, double retraction, const double r[3], double h)
 {
     double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
@@ -236,6 +236,39 @@ static inline double alpha_at(double R, double band, double retraction, const do
     double lam = fabs(r[0] / rr) + fabs(r[1] / rr) + fabs(r[2] / rr);
     double sigma = 0.065 * (1.0 - lam * lam) + 0.39;
     return alpha_of_t(d / (sigma * lam * M_SQRT2 * h));
+}
+
+/* α of the len nodes of a run (first at offset r0, spacing step along rd)
+ * of a sphere of radius R_eff = R − retraction h: the profile of
+ * alpha_at() in two loops, the first (square root, divisions) without
+ * branches so that the compiler vectorises it, the second the table
+ * look-up.  Node k is at r0 + k step and λ takes one division, so the α
+ * differ from alpha_at() by round-off; the table is 0 beyond its end, and
+ * a node at the centre, where λ is 0/0, takes its end too (α = 1). */
+static void alpha_run(double Reff, const double r0[3], int rd, double step, double h, int len,
+                      double *restrict al)
+{
+    enum { CHUNK = 64 };
+    double x[CHUNK], p2 = 0.0, pa = 0.0, tscale = alpha_scale / (M_SQRT2 * h);
+    for (int d = 0; d < 3; d++)
+        if (d != rd) p2 += r0[d] * r0[d], pa += fabs(r0[d]);
+    for (int k0 = 0; k0 < len; k0 += CHUNK) {
+        int n = len - k0 < CHUNK ? len - k0 : CHUNK;
+        double z0 = r0[rd] + k0 * step;
+        for (int k = 0; k < n; k++) {
+            double z = z0 + k * step, rr = sqrt(p2 + z * z), d = rr - Reff;
+            double lam = (pa + fabs(z)) / rr, sigma = 0.065 * (1.0 - lam * lam) + 0.39;
+            double t = d * tscale / (sigma * lam); /* t of ibm_alpha() times alpha_scale */
+            x[k] = t < -ALPHA_TABLE ? -ALPHA_TABLE : (t > ALPHA_TABLE ? ALPHA_TABLE : t);
+            x[k] = rr > 0.0 ? x[k] : -ALPHA_TABLE;
+        }
+        for (int k = 0; k < n; k++) {
+            double xa = fabs(x[k]);
+            int i = (int)xa;
+            double f = alpha_table[i] + (xa - i) * (alpha_table[i + 1] - alpha_table[i]);
+            al[k0 + k] = x[k] < 0.0 ? 1.0 - f : f;
+        }
+    }
 }
 
 /* Grid line of a run: (component, local x index[, global y index]). */
@@ -267,8 +300,8 @@ static void add_run(void *ctx, int c, long m0, int len, const double r0[3], doub
     run->line = run_line(b->ibm->g, c, m0);
 }
 
-/* Sort the generated runs into storage order (bucketed by grid line, each
- * line's list by m0, ties in generation order) and merge them into the
+/* Sort the generated runs into storage order (by grid line, each line's
+ * runs by m0, ties in generation order) and merge them into the
  * forced nodes: the runs of a line that overlap or touch become one node
  * run, each node once; every sphere run gets the index of its first node
  * (u0). */
@@ -279,29 +312,38 @@ static void sort_and_merge_runs(ibm_t *ibm)
     long st = q->rstride, nlines = (long)g->dim * g->nxl * (g->dim == 3 ? g->n[1] : 1);
     if (q->nruns > q->cap_next) {
         q->cap_next = q->cap_runs;
-        free(q->run_next);
+        free(q->run_order);
         free(q->runs);
-        q->run_next = xcalloc((size_t)q->cap_next, sizeof *q->run_next);
+        q->run_order = xcalloc((size_t)q->cap_next, sizeof *q->run_order);
         q->runs = xcalloc((size_t)q->cap_next, sizeof *q->runs);
     }
-    for (long l = 0; l < nlines; l++) q->line_head[l] = -1;
-    for (long ir = q->nruns - 1; ir >= 0; ir--) {
-        const ibm_run_t *run = &q->runs_tmp[ir];
-        int32_t *at = &q->line_head[run->line];
-        while (*at >= 0 && q->runs_tmp[*at].m0 < run->m0) at = &q->run_next[*at];
-        q->run_next[ir] = *at;
-        *at = (int32_t)ir;
+    /* counting sort by line (stable), then each line's few runs by m0
+     * (insertion sort, stable): run_order[line_head[l] .. line_head[l+1]) */
+    memset(q->line_head, 0, (size_t)(nlines + 1) * sizeof *q->line_head);
+    for (long ir = 0; ir < q->nruns; ir++) q->line_head[q->runs_tmp[ir].line + 1]++;
+    for (long l = 0; l < nlines; l++) q->line_head[l + 1] += q->line_head[l];
+    for (long ir = 0; ir < q->nruns; ir++) q->run_order[q->line_head[q->runs_tmp[ir].line]++] = (int32_t)ir;
+    for (long l = nlines; l > 0; l--) q->line_head[l] = q->line_head[l - 1];
+    q->line_head[0] = 0;
+    for (long l = 0; l < nlines; l++) {
+        int32_t *o = q->run_order + q->line_head[l];
+        int cnt = q->line_head[l + 1] - q->line_head[l];
+        for (int i = 1; i < cnt; i++) {
+            int32_t v = o[i], j = i;
+            for (; j > 0 && q->runs_tmp[o[j - 1]].m0 > q->runs_tmp[v].m0; j--) o[j] = o[j - 1];
+            o[j] = v;
+        }
     }
     long nr = 0;
     q->n_nruns = 0;
     q->nnodes = 0;
     for (long l = 0; l < nlines; l++) {
-        int32_t ir = q->line_head[l];
-        while (ir >= 0) {
-            long ms = q->runs_tmp[ir].m0, me = ms - st, n0 = q->nnodes; /* first and last node */
-            for (; ir >= 0 && q->runs_tmp[ir].m0 <= me + st; ir = q->run_next[ir]) {
+        int32_t e = q->line_head[l], end = q->line_head[l + 1];
+        while (e < end) {
+            long ms = q->runs_tmp[q->run_order[e]].m0, me = ms - st, n0 = q->nnodes; /* first and last node */
+            for (; e < end && q->runs_tmp[q->run_order[e]].m0 <= me + st; e++) {
                 ibm_run_t *o = &q->runs[nr++];
-                *o = q->runs_tmp[ir];
+                *o = q->runs_tmp[q->run_order[e]];
                 o->u0 = (int32_t)(n0 + (o->m0 - ms) / st);
                 long oe = o->m0 + (o->len - 1) * st;
                 if (oe > me) me = oe;
@@ -326,7 +368,7 @@ static void compute_alpha(ibm_t *ibm)
 {
     ibm_priv_t *q = ibm_priv(ibm);
     const grid_t *g = ibm->g;
-    double band = ibm_band_halfwidth(), retraction = ibm->prm.retraction;
+    double retraction = ibm->prm.retraction;
     long n = 0;
     for (long ir = 0; ir < q->nruns; ir++) n += q->runs[ir].len;
     if (n > q->cap_alpha) {
@@ -349,23 +391,19 @@ static void compute_alpha(ibm_t *ibm)
     q->nalpha = 0;
     for (long ir = 0; ir < q->nruns; ir++) {
         ibm_run_t *run = &q->runs[ir];
-        double R = ibm->s[run->p].radius, h = q->hcell[run->c][ibm_node_i(g, run->m0)];
-        double r[3] = {run->r0[0], run->r0[1], run->r0[2]}, *al = q->alpha + q->nalpha;
+        double h = q->hcell[run->c][ibm_node_i(g, run->m0)], *al = q->alpha + q->nalpha;
         double *A = q->node_asum + run->u0, *cnt = q->node_imp + run->u0;
         run->a0 = (int32_t)q->nalpha;
-        for (int k = 0; k < run->len; k++, r[q->rdir] += q->rstep) {
-            al[k] = alpha_at(R, band, retraction, r, h);
+        alpha_run(ibm->s[run->p].radius - retraction * h, run->r0, q->rdir, q->rstep, h, run->len, al);
+        for (int k = 0; k < run->len; k++) {
             A[k] += al[k];
             cnt[k] += 1.0;
         }
         q->nalpha += run->len;
     }
-    q->nshared = 0;
-    for (long ir = 0; ir < q->nruns; ir++) {
-        const ibm_run_t *run = &q->runs[ir];
-        const double *cnt = q->node_imp + run->u0;
-        for (int k = 0; k < run->len; k++) q->nshared += cnt[k] > 1.0;
-    }
+    double shared = 0.0;
+    for (long j = 0; j < q->nnodes; j++) shared += q->node_imp[j] > 1.0 ? q->node_imp[j] : 0.0;
+    q->nshared = (long)shared;
 }
 
 void ibm_build_nodes(ibm_t *ibm)

@@ -77,7 +77,7 @@ static inline double forcing_beta(double a, double dt, double tau)
  * impulse, exactly.)  Three passes: targets (set_targets), forcing of the
  * nodes (force_nodes, streaming over the node runs, as often as there are
  * forcings), and each sphere's share of the accumulated impulses
- * (gather_impulses). */
+ * (sphere_sums). */
 
 /* Ū at every forced node from the spheres' current velocities, and the
  * accumulated impulses reset. */
@@ -134,63 +134,58 @@ static void force_nodes(ibm_t *ibm, double dt)
     }
 }
 
-/* Each sphere's share of the accumulated impulses: ∫ f dV Δt and its
- * moment into sum[IBM_FIMP..IBM_TIMP+2] (overwritten).  The runs are in
- * storage order; each sphere's sums are carried from run to run. */
-static void gather_impulses(ibm_t *ibm)
-{
-    const grid_t *g = ibm->g;
-    ibm_priv_t *q = ibm_priv(ibm);
-    double step = q->rstep;
-    int rd = q->rdir;
-    for (int p = 0; p < ibm->n; p++)
-        for (int d = 0; d < 6; d++) q->sum[(long)p * IBM_NSUM + IBM_FIMP + d] = 0.0;
-    for (long ir = 0; ir < q->nruns; ir++) {
-        const ibm_run_t *run = &q->runs[ir];
-        int c = run->c;
-        double *sum = q->sum + (long)run->p * IBM_NSUM, t[3];
-        double T[3] = {sum[IBM_TIMP], sum[IBM_TIMP + 1], sum[IBM_TIMP + 2]};
-        const double *al = q->alpha + run->a0, *A = q->node_asum + run->u0, *imp = q->node_imp + run->u0;
-        double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]}, jr = 0;
-        for (int k = 0; k < run->len; k++, r[rd] += step) {
-            if (!(al[k] > 0.0)) continue;
-            double share = al[k] / A[k] * imp[k];
-            jr += share;
-            cross_axis(r, c, share, t);
-            for (int d = 0; d < 3; d++) T[d] += t[d] * vol;
-        }
-        sum[IBM_FIMP + c] += jr * vol;
-        for (int d = 0; d < 3; d++) sum[IBM_TIMP + d] = T[d];
-    }
-}
-
-/* ∫ α_p u dV and ∫ α_p r × u dV of every sphere on this rank into
- * sum[IBM_MOM..IBM_ANG+2]. */
-void ibm_momentum(ibm_t *ibm, double *sum_all)
+/* Per-sphere sums over the runs (in storage order, each sphere's sums
+ * carried from run to run), overwritten in sum_all:
+ *  impulses: each sphere's share α_p/Σα of the accumulated forcing
+ *            impulses, ∫ f dV Δt and its moment, into IBM_FIMP..IBM_TIMP+2;
+ *  momentum: ∫ α_p u dV and ∫ α_p r × u dV into IBM_MOM..IBM_ANG+2. */
+static void sphere_sums(ibm_t *ibm, double *sum_all, int impulses, int momentum)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
     long st = q->rstride;
+    double step = q->rstep;
     int rd = q->rdir;
     for (int p = 0; p < ibm->n; p++)
-        for (int d = 0; d < 6; d++) sum_all[(long)p * IBM_NSUM + IBM_MOM + d] = 0.0;
+        for (int d = 0; d < 6; d++) {
+            if (impulses) sum_all[(long)p * IBM_NSUM + IBM_FIMP + d] = 0.0;
+            if (momentum) sum_all[(long)p * IBM_NSUM + IBM_MOM + d] = 0.0;
+        }
     for (long ir = 0; ir < q->nruns; ir++) {
         const ibm_run_t *run = &q->runs[ir];
         int c = run->c;
         double *sum = sum_all + (long)run->p * IBM_NSUM, t[3];
+        double T[3] = {sum[IBM_TIMP], sum[IBM_TIMP + 1], sum[IBM_TIMP + 2]};
         double Lm[3] = {sum[IBM_ANG], sum[IBM_ANG + 1], sum[IBM_ANG + 2]};
-        const double *u = ibm->f->u[c] + run->m0, *al = q->alpha + run->a0;
-        double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]}, s = 0;
-        for (int k = 0; k < run->len; k++, r[rd] += q->rstep) {
-            double a = al[k] * u[k * st];
-            s += a;
-            cross_axis(r, c, a * vol, t);
-            for (int d = 0; d < 3; d++) Lm[d] += t[d];
+        const double *al = q->alpha + run->a0, *A = q->node_asum + run->u0, *imp = q->node_imp + run->u0;
+        const double *u = ibm->f->u[c] + run->m0;
+        double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]}, jr = 0, s = 0;
+        for (int k = 0; k < run->len; k++, r[rd] += step) {
+            if (impulses && al[k] > 0.0) {
+                double share = al[k] / A[k] * imp[k];
+                jr += share;
+                cross_axis(r, c, share, t);
+                for (int d = 0; d < 3; d++) T[d] += t[d] * vol;
+            }
+            if (momentum) {
+                double a = al[k] * u[k * st];
+                s += a;
+                cross_axis(r, c, a * vol, t);
+                for (int d = 0; d < 3; d++) Lm[d] += t[d];
+            }
         }
-        sum[IBM_MOM + c] += s * vol;
-        for (int d = 0; d < 3; d++) sum[IBM_ANG + d] = Lm[d];
+        if (impulses) {
+            sum[IBM_FIMP + c] += jr * vol;
+            for (int d = 0; d < 3; d++) sum[IBM_TIMP + d] = T[d];
+        }
+        if (momentum) {
+            sum[IBM_MOM + c] += s * vol;
+            for (int d = 0; d < 3; d++) sum[IBM_ANG + d] = Lm[d];
+        }
     }
 }
+
+void ibm_momentum(ibm_t *ibm, double *sum_all) { sphere_sums(ibm, sum_all, 0, 1); }
 
 static void reduce_sums(ibm_t *ibm)
 {
@@ -253,7 +248,7 @@ void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
     }
     force_nodes(ibm, dt_stage);
     /* the impulses of the stage, before the solid fraction moves */
-    if (!q->frozen) gather_impulses(ibm);
+    if (!q->frozen) sphere_sums(ibm, q->sum, 1, 0);
     ibm->wall_forcing += wtime() - w0;
 }
 
@@ -386,8 +381,7 @@ void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx)
         /* nothing moves within the step: one impulse for the whole step */
         if (stage < 2) return;
         double w0 = wtime();
-        gather_impulses(ibm);
-        ibm_momentum(ibm, q->sum);
+        sphere_sums(ibm, q->sum, 1, 1);
         reduce_sums(ibm);
         for (int p = 0; p < ibm->n; p++) {
             double J[3], K[3];

@@ -239,7 +239,7 @@ void ibm_free(ibm_t *ibm)
     free(q->node_target);
     free(q->node_imp);
     free(q->line_head);
-    free(q->run_next);
+    free(q->run_order);
     free(q->runs_tmp);
     free(q->sum);
     free(q->mom_prev);

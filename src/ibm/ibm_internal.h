@@ -62,8 +62,8 @@ typedef struct {
     long n_nruns, cap_nruns;
     double *node_asum, *node_target, *node_imp;
     long nnodes, cap_nodes;
-    int32_t *line_head;  /* scratch of the merge: runs by grid line */
-    int32_t *run_next;
+    int32_t *line_head;  /* scratch of the sort: first of each grid line's runs in run_order */
+    int32_t *run_order;
     long cap_next;
     int built;         /* node lists exist */
     int frozen;        /* this step: no sphere moves within it (forcing.c) */
