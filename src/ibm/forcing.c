@@ -46,6 +46,7 @@
  *     Δu = g Δt_k − ρ ∫ f dV Δt_k / ((ρ_p − ρ) V_p).
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "ibm_internal.h"
@@ -210,10 +211,62 @@ void ibm_rebuild_geometry(ibm_t *ibm)
     ibm->wall_integrals += wtime() - w1;
 }
 
+/* The shortest displacement from a to b (periodic directions: the nearest
+ * image). */
+static void displacement(const grid_t *g, const double a[3], const double b[3], double dx[3])
+{
+    for (int d = 0; d < 3; d++) {
+        dx[d] = b[d] - a[d];
+        if (d < g->dim && g->periodic[d]) dx[d] -= g->L[d] * round(dx[d] / g->L[d]);
+    }
+}
+
+/* Spheres moved from outside (coupling): α at the new centres.  Fixed and
+ * external spheres keep the momentum I, L of the fluid of their last
+ * solid fraction (the end of the last step), with L taken about the new
+ * centre (L − δ × I for a displacement δ): the next step's impulse
+ * ρ(I^3 − I^0) then contains the change of the momentum inside the sphere
+ * due to its jump, and the impulses telescope over the steps as they do
+ * over the stages (docs/theory.md §6b).  Free and prescribed spheres take
+ * the momentum at their new solid fraction. */
 void ibm_update_geometry(ibm_t *ibm)
 {
+    ibm_priv_t *q = ibm_priv(ibm);
+    int moved = 0, others = 0;
+    for (int p = 0; p < ibm->n; p++) {
+        ibm_sphere_t *s = &ibm->s[p];
+        moved |= memcmp(s->xa, s->x, sizeof s->x) != 0;
+        if (s->kind != IBM_FIXED && s->kind != IBM_EXTERNAL) {
+            others = 1;
+            continue;
+        }
+        double dx[3], *I = q->mom_prev + 6 * p, *L = I + 3;
+        displacement(ibm->g, s->xa, s->x, dx);
+        L[0] -= dx[1] * I[2] - dx[2] * I[1];
+        L[1] -= dx[2] * I[0] - dx[0] * I[2];
+        L[2] -= dx[0] * I[1] - dx[1] * I[0];
+    }
+    if (!q->built || others) {
+        for (int p = 0; p < ibm->n; p++) memcpy(ibm->s[p].xa, ibm->s[p].x, sizeof ibm->s[p].x);
+        if (!q->built) {
+            ibm_rebuild_geometry(ibm);
+            return;
+        }
+        /* the momentum of the free and prescribed spheres at their new α */
+        double *keep = xcalloc(6 * (size_t)ibm->n, sizeof(double));
+        memcpy(keep, q->mom_prev, 6 * (size_t)ibm->n * sizeof(double));
+        ibm_rebuild_geometry(ibm);
+        for (int p = 0; p < ibm->n; p++)
+            if (ibm->s[p].kind == IBM_FIXED || ibm->s[p].kind == IBM_EXTERNAL)
+                memcpy(q->mom_prev + 6 * p, keep + 6 * p, 6 * sizeof(double));
+        free(keep);
+        return;
+    }
+    if (!moved) return; /* the node lists are those of these centres */
+    double w0 = wtime();
     for (int p = 0; p < ibm->n; p++) memcpy(ibm->s[p].xa, ibm->s[p].x, sizeof ibm->s[p].x);
-    ibm_rebuild_geometry(ibm);
+    ibm_build_nodes(ibm);
+    ibm->wall_alpha += wtime() - w0;
 }
 
 /* Do all spheres keep their position and velocity over the fluid step
@@ -313,9 +366,12 @@ static void update_sphere(ibm_t *ibm, int p, double dt, double t_end, double J[3
     double u0[3], w0[3], du[3] = {0, 0, 0}, dw[3] = {0, 0, 0};
     memcpy(u0, s->u, sizeof u0);
     memcpy(w0, s->omega, sizeof w0);
+    /* the reference point of L moves with the solid fraction: not so for
+     * fixed and external spheres, whose α stays where it is over the step */
+    double dt_ref = s->kind == IBM_FIXED || s->kind == IBM_EXTERNAL ? 0.0 : dt;
     for (int c = 0; c < 3; c++) {
         J[c] = rho * (sum[IBM_MOM + c] - prev[c] - sum[IBM_FIMP + c]);
-        K[c] = rho * (sum[IBM_ANG + c] - prev[3 + c] + dt * uxI[c] - sum[IBM_TIMP + c]);
+        K[c] = rho * (sum[IBM_ANG + c] - prev[3 + c] + dt_ref * uxI[c] - sum[IBM_TIMP + c]);
     }
     switch (s->kind) {
     case IBM_FREE: {
