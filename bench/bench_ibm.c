@@ -2,16 +2,24 @@
  * integrals and sphere update, at all three RK3 stages) for many spheres,
  * as a fraction of the cost of the fluid step it is part of.
  *
- * Scene: a triply periodic box of N³ cells, Δx = D/dpd, with `count` free
- * spheres (ρ_p/ρ = 2, under gravity) placed at random without overlap
- * (random sequential addition, fixed seed).  The fluid alone is timed over
- * `steps` steps, then the same steps with the spheres: the immersed
- * boundary's own timers (ibm->wall_*) give its cost, and the difference of
- * the two step times checks them.
+ * Scene: a triply periodic box of N³ cells, Δx = D/dpd, with `count`
+ * spheres placed at random without overlap (random sequential addition,
+ * fixed seed).  The fluid alone is timed over `steps` steps, then the same
+ * steps with the spheres, in three variants (one warm-up step each):
+ *   external_moving  external spheres (the DEM-coupled kind) moved by
+ *                    0.01 Δx along a random direction before every step,
+ *                    with the matching velocity, ibm_update_geometry() —
+ *                    the realistic case: α rebuilt once per step;
+ *   external_rest    external spheres at rest (α built once);
+ *   free             free spheres (ρ_p/ρ = 2 under gravity): α rebuilt
+ *                    after every stage.
+ * The immersed boundary's own timers (ibm->wall_*) give its cost, and the
+ * difference of the step times with and without spheres checks them.
  *
  * usage: bench_ibm [N=128] [count=1000] [dpd=10] [steps=3] [explicit|implicit]
- * prints: fluid step, immersed-boundary time per step (α, forcing,
- * integrals), its fraction of the fluid step, node entries per sphere.
+ * prints, per variant: the fluid step with the spheres, the immersed
+ * boundary's time per step (α, forcing, integrals), its fraction of the
+ * fluid step alone, node entries per sphere; and one ibm_result line each.
  */
 #include <math.h>
 #include <stdio.h>
@@ -155,7 +163,7 @@ int main(int argc, char **argv)
         msg("    immersed boundary per step  %8.4f s: alpha %.4f, forcing %.4f, integrals + update %.4f\n", w[3],
             w[0], w[1], w[2]);
         msg("    fraction of the fluid step  %8.1f %%  (target <= 25 %%)\n", 100 * w[3] / t_fluid);
-        msg("    node entries per sphere     %8.0f, %.1f %% in runs shared with a neighbour\n", nodes / count,
+        msg("    node entries per sphere     %8.0f, %.1f %% at nodes shared with another sphere\n", nodes / count,
             100 * shared / nodes);
         /* one line per variant for bench/run.sh */
         msg("ibm_result case=%s N=%d spheres=%d dpd=%g ranks=%d viscous=%s fluid_step=%.4f with_ibm=%.4f ibm=%.4f "

@@ -11,7 +11,8 @@
  * fixed, prescribed (a constant velocity or a velocity history) and external
  * (moved by another module: the coupling with the DEM sets x, u, ω between
  * fluid steps, calls ibm_update_geometry(), and reads the hydrodynamic force
- * and torque of the step after fluid_step()).
+ * and torque of the step after fluid_step(); within the step an external
+ * sphere's solid fraction stays where it was put, forced with U + ω × r).
  *
  * It works through the fluid's two stage hooks (fluid.h): at every RK3
  * stage, before the projection, the predicted velocity is forced towards the
@@ -30,7 +31,12 @@
  *
  * Cost: each sphere touches only the nodes of its bounding box (radius plus
  * the band where 0 < α < 1): O(N_p (D/Δx)³) per stage, independent of the
- * grid size apart from one dense scratch field per velocity component.
+ * grid size.  The node lists of all spheres are kept in storage order and
+ * merged so that a node in several spheres' bands is forced once.  When
+ * every sphere is fixed or external (nothing moves within the step), α is
+ * built only when a sphere moved (ibm_update_geometry), the targets of the
+ * forcing once per step, and the impulse of each sphere once per step
+ * (docs/theory.md §6b).
  */
 #ifndef IBMDEM_IBM_H
 #define IBMDEM_IBM_H
@@ -89,7 +95,7 @@ struct ibm {
      * integrals, particle update) since creation */
     double wall_alpha, wall_forcing, wall_integrals;
     long nodes_forced;     /* node entries (sphere, node) of the last stage, this rank */
-    long nodes_shared;     /* ... of them in runs that another sphere's band may reach */
+    long nodes_shared;     /* ... of them at nodes that another sphere's band reaches too */
     void *priv;
 };
 
@@ -118,9 +124,13 @@ int ibm_add_history(ibm_t *ibm, int n, const double *rows);
 /* Velocity and angular velocity of a prescribed sphere at time t. */
 void ibm_prescribed_velocity(const ibm_t *ibm, const ibm_sphere_t *s, double t, double u[3], double w[3]);
 
-/* Rebuild the solid fraction and the momentum inside each sphere from the
- * current positions (xa = x) and fluid velocity: after changing spheres
- * from outside (coupling).  Collective. */
+/* After changing spheres from outside (coupling): the solid fraction at
+ * the current positions (xa = x; nothing is rebuilt if no sphere moved).
+ * Free and prescribed spheres take the momentum inside them from the
+ * current fluid velocity; fixed and external ones keep that of their last
+ * solid fraction (angular momentum taken about the new centre), so that
+ * the next step's force contains the momentum change of their jump.
+ * Collective. */
 void ibm_update_geometry(ibm_t *ibm);
 /* The same from the stored xa (restart, rollback: the state as it was). */
 void ibm_rebuild_geometry(ibm_t *ibm);
