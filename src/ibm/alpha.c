@@ -310,7 +310,7 @@ static void sort_and_merge_runs(ibm_t *ibm)
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
     long st = q->rstride, nlines = (long)g->dim * g->nxl * (g->dim == 3 ? g->n[1] : 1);
-    if (q->nruns > q->cap_next) {
+    if (q->nruns > q->cap_next || !q->runs) { /* (allocated even when empty: memset of NULL is undefined) */
         q->cap_next = q->cap_runs;
         free(q->run_order);
         free(q->runs);
@@ -371,12 +371,12 @@ static void compute_alpha(ibm_t *ibm)
     double retraction = ibm->prm.retraction;
     long n = 0;
     for (long ir = 0; ir < q->nruns; ir++) n += q->runs[ir].len;
-    if (n > q->cap_alpha) {
+    if (n > q->cap_alpha || !q->alpha) {
         q->cap_alpha = n + n / 4;
         free(q->alpha);
         q->alpha = xcalloc((size_t)q->cap_alpha, sizeof *q->alpha);
     }
-    if (q->nnodes > q->cap_nodes) {
+    if (q->nnodes > q->cap_nodes || !q->node_asum) {
         q->cap_nodes = q->nnodes + q->nnodes / 4;
         free(q->node_asum);
         free(q->node_target);
