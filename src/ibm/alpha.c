@@ -417,6 +417,7 @@ void ibm_build_nodes(ibm_t *ibm)
     sort_and_merge_runs(ibm);
     compute_alpha(ibm);
     q->built = 1;
+    q->targets_valid = 0;
     ibm->nodes_forced = q->nalpha;
     ibm->nodes_shared = q->nshared;
 }

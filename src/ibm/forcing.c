@@ -81,14 +81,26 @@ static inline double forcing_beta(double a, double dt, double tau)
  * (sphere_sums). */
 
 /* Ū at every forced node from the spheres' current velocities, and the
- * accumulated impulses reset. */
+ * accumulated impulses reset.  Ū is kept when neither the node lists nor
+ * any sphere's velocity changed since it was set (spheres at rest, a fixed
+ * bed: the pass is skipped). */
 static void set_targets(ibm_t *ibm)
 {
     ibm_priv_t *q = ibm_priv(ibm);
     double step = q->rstep;
     int rd = q->rdir;
+    q->imp_fresh = 1; /* the next forcing starts the accumulation */
+    int same = q->targets_valid;
+    for (int p = 0; p < ibm->n && same; p++)
+        same = !memcmp(q->target_vel + 6 * p, ibm->s[p].u, 3 * sizeof(double)) &&
+               !memcmp(q->target_vel + 6 * p + 3, ibm->s[p].omega, 3 * sizeof(double));
+    if (same) return;
+    for (int p = 0; p < ibm->n; p++) {
+        memcpy(q->target_vel + 6 * p, ibm->s[p].u, 3 * sizeof(double));
+        memcpy(q->target_vel + 6 * p + 3, ibm->s[p].omega, 3 * sizeof(double));
+    }
+    q->targets_valid = 1;
     memset(q->node_target, 0, (size_t)q->nnodes * sizeof(double));
-    memset(q->node_imp, 0, (size_t)q->nnodes * sizeof(double));
     for (long ir = 0; ir < q->nruns; ir++) {
         const ibm_run_t *run = &q->runs[ir];
         const ibm_sphere_t *s = &ibm->s[run->p];
@@ -100,29 +112,40 @@ static void set_targets(ibm_t *ibm)
 }
 
 /* One forcing u ← u + β (Ū − u) of every forced node, the impulse added
- * to node_imp. */
+ * to node_imp (stored by the first forcing after set_targets). */
 static void force_nodes(ibm_t *ibm, double dt)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
     double kappa = ibm->prm.forcing_time, nu = ibm->f->prm.nu;
     long st = q->rstride;
+    int fast = kappa <= 0 && st == 1, first = q->imp_fresh;
+    q->imp_fresh = 0;
+    if (first && !fast) memset(q->node_imp, 0, (size_t)q->nnodes * sizeof(double));
     for (long ir = 0; ir < q->n_nruns; ir++) {
         const ibm_node_run_t *nr = &q->nruns_f[ir];
         double *u = ibm->f->u[nr->c] + nr->m0, *J = q->node_imp + nr->n0;
         const double *A = q->node_asum + nr->n0, *T = q->node_target + nr->n0;
         int len = nr->len;
-        if (kappa > 0) {
+        if (fast) { /* the seed's β = α, unit stride: vectorised; the
+                     * first forcing writes J without reading it */
+            if (first)
+                for (int k = 0; k < len; k++) {
+                    double imp = (A[k] < 1.0 ? A[k] : 1.0) * (T[k] - u[k]);
+                    u[k] += imp;
+                    J[k] = imp;
+                }
+            else
+                for (int k = 0; k < len; k++) {
+                    double imp = (A[k] < 1.0 ? A[k] : 1.0) * (T[k] - u[k]);
+                    u[k] += imp;
+                    J[k] += imp;
+                }
+        } else if (kappa > 0) {
             double h = q->hcell[nr->c][ibm_node_i(g, nr->m0)], tau = kappa * h * h / nu;
             for (int k = 0; k < len; k++) {
                 double imp = forcing_beta(A[k] < 1.0 ? A[k] : 1.0, dt, tau) * (T[k] - u[k * st]);
                 u[k * st] += imp;
-                J[k] += imp;
-            }
-        } else if (st == 1) { /* the seed's β = α, unit stride: vectorised */
-            for (int k = 0; k < len; k++) {
-                double imp = (A[k] < 1.0 ? A[k] : 1.0) * (T[k] - u[k]);
-                u[k] += imp;
                 J[k] += imp;
             }
         } else {

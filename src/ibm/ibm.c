@@ -206,6 +206,7 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
     q->rstep = g->dim == 3 ? g->dz : g->dy;
     q->sum = xcalloc(nn * IBM_NSUM, sizeof(double));
     q->mom_prev = xcalloc(nn * 6, sizeof(double));
+    q->target_vel = xcalloc(nn * 6, sizeof(double));
     q->imp_step = xcalloc(nn * 6, sizeof(double));
     f->stage_hook = ibm_stage_force;
     f->stage_end_hook = ibm_stage_end;
@@ -243,6 +244,7 @@ void ibm_free(ibm_t *ibm)
     free(q->runs_tmp);
     free(q->sum);
     free(q->mom_prev);
+    free(q->target_vel);
     free(q->imp_step);
     free(q);
     free(ibm->s);

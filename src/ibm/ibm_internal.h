@@ -66,6 +66,9 @@ typedef struct {
     int32_t *run_order;
     long cap_next;
     int built;         /* node lists exist */
+    int imp_fresh;     /* node_imp is to be restarted by the next forcing */
+    int targets_valid; /* node_target was set from these node lists and the velocities in target_vel */
+    double *target_vel; /* n × 6: u, ω of each sphere when node_target was set */
     int frozen;        /* this step: no sphere moves within it (forcing.c) */
     /* control volume of each unknown by local x index (−1..nxl), times 2π
      * in axisymmetric geometry: the integrals are over the whole volume */
