@@ -250,54 +250,6 @@ static void displacement(const grid_t *g, const double a[3], const double b[3], 
     }
 }
 
-/* Spheres moved from outside (coupling): α at the new centres.  Fixed and
- * external spheres keep the momentum I, L of the fluid of their last
- * solid fraction (the end of the last step), with L taken about the new
- * centre (L − δ × I for a displacement δ): the next step's impulse
- * ρ(I^3 − I^0) then contains the change of the momentum inside the sphere
- * due to its jump, and the impulses telescope over the steps as they do
- * over the stages (docs/theory.md §6b).  Free and prescribed spheres take
- * the momentum at their new solid fraction. */
-void ibm_update_geometry(ibm_t *ibm)
-{
-    ibm_priv_t *q = ibm_priv(ibm);
-    int moved = 0, others = 0;
-    for (int p = 0; p < ibm->n; p++) {
-        ibm_sphere_t *s = &ibm->s[p];
-        moved |= memcmp(s->xa, s->x, sizeof s->x) != 0;
-        if (s->kind != IBM_FIXED && s->kind != IBM_EXTERNAL) {
-            others = 1;
-            continue;
-        }
-        double dx[3], *I = q->mom_prev + 6 * p, *L = I + 3;
-        displacement(ibm->g, s->xa, s->x, dx);
-        L[0] -= dx[1] * I[2] - dx[2] * I[1];
-        L[1] -= dx[2] * I[0] - dx[0] * I[2];
-        L[2] -= dx[0] * I[1] - dx[1] * I[0];
-    }
-    if (!q->built || others) {
-        for (int p = 0; p < ibm->n; p++) memcpy(ibm->s[p].xa, ibm->s[p].x, sizeof ibm->s[p].x);
-        if (!q->built) {
-            ibm_rebuild_geometry(ibm);
-            return;
-        }
-        /* the momentum of the free and prescribed spheres at their new α */
-        double *keep = xcalloc(6 * (size_t)ibm->n, sizeof(double));
-        memcpy(keep, q->mom_prev, 6 * (size_t)ibm->n * sizeof(double));
-        ibm_rebuild_geometry(ibm);
-        for (int p = 0; p < ibm->n; p++)
-            if (ibm->s[p].kind == IBM_FIXED || ibm->s[p].kind == IBM_EXTERNAL)
-                memcpy(q->mom_prev + 6 * p, keep + 6 * p, 6 * sizeof(double));
-        free(keep);
-        return;
-    }
-    if (!moved) return; /* the node lists are those of these centres */
-    double w0 = wtime();
-    for (int p = 0; p < ibm->n; p++) memcpy(ibm->s[p].xa, ibm->s[p].x, sizeof ibm->s[p].x);
-    ibm_build_nodes(ibm);
-    ibm->wall_alpha += wtime() - w0;
-}
-
 /* Do all spheres keep their position and velocity over the fluid step
  * (fixed spheres, and external ones, which the coupling moves between
  * steps)?  Then the solid fraction and the targets Ū stay as they are over
@@ -312,17 +264,74 @@ static int step_frozen(const ibm_t *ibm)
     return 1;
 }
 
+/* Fixed and external spheres set to new centres x from outside: each keeps
+ * the momentum I, L of the fluid of its last solid fraction (centre xa),
+ * with L taken about the new centre (L − δ × I for the displacement δ), so
+ * that the next impulse ρ(I^k − I^{k−1}) contains the change of the
+ * momentum inside the sphere due to its jump and the impulses telescope
+ * over the steps as they do over the stages (docs/theory.md §6b); then
+ * xa = x.  Returns whether any of them moved (the node lists are to be
+ * rebuilt). */
+static int carry_external_moves(ibm_t *ibm)
+{
+    ibm_priv_t *q = ibm_priv(ibm);
+    int moved = 0;
+    for (int p = 0; p < ibm->n; p++) {
+        ibm_sphere_t *s = &ibm->s[p];
+        if ((s->kind != IBM_FIXED && s->kind != IBM_EXTERNAL) || !memcmp(s->xa, s->x, sizeof s->x)) continue;
+        double dx[3], *I = q->mom_prev + 6 * p, *L = I + 3;
+        displacement(ibm->g, s->xa, s->x, dx);
+        L[0] -= dx[1] * I[2] - dx[2] * I[1];
+        L[1] -= dx[2] * I[0] - dx[0] * I[2];
+        L[2] -= dx[0] * I[1] - dx[1] * I[0];
+        memcpy(s->xa, s->x, sizeof s->x);
+        moved = 1;
+    }
+    return moved;
+}
+
+/* Spheres moved from outside (coupling).  When every sphere is fixed or
+ * external, the move is applied at the start of the next fluid step
+ * (carry_external_moves from ibm_stage_force): between steps the solid
+ * fraction stays the one the last step used, so a checkpoint or a rollback
+ * taken there holds the centres (xa) of the carried momentum and a restart
+ * rebuilds it exactly.  Otherwise at once: free and prescribed spheres take
+ * the momentum at their new solid fraction. */
+void ibm_update_geometry(ibm_t *ibm)
+{
+    ibm_priv_t *q = ibm_priv(ibm);
+    if (!q->built) {
+        for (int p = 0; p < ibm->n; p++) memcpy(ibm->s[p].xa, ibm->s[p].x, sizeof ibm->s[p].x);
+        ibm_rebuild_geometry(ibm);
+        return;
+    }
+    if (step_frozen(ibm)) return;
+    carry_external_moves(ibm);
+    double *keep = xcalloc(6 * (size_t)ibm->n, sizeof(double));
+    memcpy(keep, q->mom_prev, 6 * (size_t)ibm->n * sizeof(double));
+    for (int p = 0; p < ibm->n; p++) memcpy(ibm->s[p].xa, ibm->s[p].x, sizeof ibm->s[p].x);
+    ibm_rebuild_geometry(ibm);
+    for (int p = 0; p < ibm->n; p++)
+        if (ibm->s[p].kind == IBM_FIXED || ibm->s[p].kind == IBM_EXTERNAL)
+            memcpy(q->mom_prev + 6 * p, keep + 6 * p, 6 * sizeof(double));
+    free(keep);
+}
+
 void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
 {
     ibm_t *ibm = ctx;
     ibm_priv_t *q = ibm_priv(ibm);
-    double w0 = wtime();
     if (stage == 0) {
         q->t_step = 0.0;
         q->t_stage0 = f->time;
         memset(q->imp_step, 0, (size_t)ibm->n * 6 * sizeof(double));
         q->frozen = step_frozen(ibm);
+        /* the moves made since the last step (ibm_update_geometry) */
+        double w0 = wtime();
+        if (q->frozen && carry_external_moves(ibm)) ibm_build_nodes(ibm);
+        ibm->wall_alpha += wtime() - w0;
     }
+    double w0 = wtime();
     if (stage == 0 || !q->frozen) set_targets(ibm);
     for (int it = 0; it < ibm->prm.forcing_iterations; it++) {
         force_nodes(ibm, dt_stage);
