@@ -85,6 +85,9 @@ double dem_time(const dem_t *d);
 double dem_contact_time(const dem_t *d);
 void dem_set_time(dem_t *d, double t);
 void dem_set_gravity(dem_t *d, const double g[3]);
+void dem_get_gravity(const dem_t *d, double g[3]);
+/* The dry restitution coefficient e_dry (ε_max) of the contact law (0 if given by stiffness). */
+double dem_dry_restitution(const dem_t *d);
 
 /* Particle arrays (3-vectors are stored x,y,z per particle). */
 int dem_count(const dem_t *d);
@@ -101,6 +104,25 @@ double *dem_ext_force(dem_t *d);
 double *dem_ext_torque(dem_t *d);
 /* Total contact force of each particle (pairs and walls) at the last step. */
 const double *dem_contact_forces(const dem_t *d);
+
+/* Brenner lubrication (lubrication.c; [lubrication] in a case file):
+ * viscosity η_f (≤ 0: off), η_e/R, Δ_lub/R, subtract the force at Δ_lub,
+ * also against walls.  Call before the first step. */
+void dem_set_lubrication(dem_t *d, double viscosity, double roughness, double range, int subtract, int walls);
+void dem_lubrication_register_keys(void);
+/* Lubrication force on each particle in the last step (impulse / dt), 3n;
+ * pairs and walls that exchanged a lubrication impulse in the last step. */
+const double *dem_lubrication_forces(const dem_t *d);
+long dem_lubrication_active(const dem_t *d);
+/* Time until the first particle–particle or particle–wall contact at the
+ * current velocities (0: a contact exists; INFINITY: nothing approaches). */
+double dem_time_to_contact(const dem_t *d);
+/* A function called after every DEM step (NULL: none), e.g. to record the
+ * motion at the resolution of the sub-steps. */
+void dem_set_step_observer(dem_t *d, void (*fn)(dem_t *d, void *ctx), void *ctx);
+/* Velocity of particle i at the end of the current step (inside an observer
+ * the stored velocities are half-step values). */
+void dem_full_velocity(const dem_t *d, int i, double vel[3]);
 
 /* Bytes allocated by the DEM per particle (particles, lists, cells, walls). */
 double dem_memory_per_particle(const dem_t *d);

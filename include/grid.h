@@ -27,7 +27,7 @@
 
 typedef enum { GEOM_3D = 0, GEOM_2D = 1, GEOM_AXI = 2 } geom_t;
 typedef enum { BC_PERIODIC = 0, BC_NOSLIP = 1, BC_FREESLIP = 2, BC_AXIS = 3 } bc_type_t;
-typedef enum { STRETCH_UNIFORM = 0, STRETCH_TANH_LOW, STRETCH_TANH_HIGH, STRETCH_TANH_BOTH } stretch_t;
+typedef enum { STRETCH_UNIFORM = 0, STRETCH_TANH_LOW, STRETCH_TANH_HIGH, STRETCH_TANH_BOTH, STRETCH_UNIFORM_ARITHMETIC } stretch_t;
 
 typedef struct {
     bc_type_t type[3][2]; /* [direction][0 = low face, 1 = high face] */
@@ -44,6 +44,8 @@ typedef struct grid {
     bc_t bc;
     stretch_t stretch;
     double stretch_beta;
+    int stretch_uniform_cells;     /* uniform_arithmetic: cells of the uniform part from the low face */
+    double stretch_uniform_length; /* ... and its length */
 
     /* decomposition: slabs in x */
     MPI_Comm comm;
@@ -77,6 +79,11 @@ grid_t *grid_create_from_config(cfg_t *cfg, MPI_Comm comm);
  * GEOM_2D/GEOM_AXI, n[2] must be 1. */
 grid_t *grid_create(geom_t geom, const int n[3], const double L[3], const double x0[3], const bc_t *bc,
                     stretch_t stretch, double beta, MPI_Comm comm);
+/* The same with the uniform_arithmetic spacing in x: nu cells of size lu/nu
+ * from the low face, then sizes growing in arithmetic progression (Izard's
+ * bouncing-sphere grid, §2.6 of the reference notes). */
+grid_t *grid_create_uniform_arithmetic(geom_t geom, const int n[3], const double L[3], const double x0[3], const bc_t *bc,
+                                       int nu, double lu, MPI_Comm comm);
 void grid_free(grid_t *g);
 
 double *field_alloc(const grid_t *g);

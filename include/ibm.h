@@ -106,6 +106,9 @@ void ibm_register_keys(void);
  * spheres and attach to the fluid (its stage hooks).  Stops with
  * file:line: ibm.key: reason on bad input. */
 ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f);
+/* The same with extra spheres appended after those of [ibm] (the DEM
+ * particles of a coupled scene, kind external); [ibm] may then define none. */
+ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *extra, int nextra);
 
 /* ---- programmatic use (tests, coupling) -------------------------------------- */
 

@@ -60,6 +60,9 @@ typedef struct sim_part {
     void (*checkpoint_read)(void *ctx, hid_t group, const char *path);
     /* Final results for summary.json (keys are prefixed with the part's name). */
     void (*summary)(void *ctx, io_summary_t *s, const char *prefix);
+    /* Non-zero when the part has what the run was for (e.g. a measured
+     * bounce): the run stops as at t_end.  NULL: never. */
+    int (*done)(void *ctx);
     void (*destroy)(void *ctx);
 } sim_part_t;
 
@@ -86,7 +89,7 @@ typedef struct {
  * io_snapshot_end of every snapshot. */
 typedef void (*sim_field_writer_t)(void *ctx, io_snapshots_t *snap);
 
-typedef enum { SIM_RUNNING = 0, SIM_T_END, SIM_MAX_STEPS, SIM_WALL_LIMIT, SIM_STEADY, SIM_DIVERGED } sim_status_t;
+typedef enum { SIM_RUNNING = 0, SIM_T_END, SIM_MAX_STEPS, SIM_WALL_LIMIT, SIM_STEADY, SIM_DIVERGED, SIM_DONE } sim_status_t;
 
 struct sim {
     cfg_t *cfg;
@@ -148,10 +151,23 @@ void sim_add_fluid(sim_t *s, cfg_t *cfg);
 void sim_add_dem(sim_t *s, cfg_t *cfg);
 /* The DEM engine of the run (its packing prepared), NULL without particles. */
 struct dem *sim_dem_engine(sim_t *s);
+/* The same before the packing preparation (while building the scene). */
+struct dem *sim_dem_engine_unprepared(sim_t *s);
 /* The pore-network fluid (sim_porenet.c): built when the case has a [porenet] section. */
 void sim_add_porenet(sim_t *s, cfg_t *cfg);
 /* The immersed-boundary part (sim_ibm.c): built when the case has an [ibm]
  * section; needs the fluid (its stage hooks do the work). */
 void sim_add_ibm(sim_t *s, cfg_t *cfg);
+/* The same with extra spheres after those of [ibm] (the DEM particles of a
+ * coupled scene); returns the immersed boundary. */
+struct ibm *sim_add_ibm_with(sim_t *s, cfg_t *cfg, const void *extra_spheres, int nextra);
+/* A DEM advanced by another part (the coupling): its own advance does nothing. */
+void sim_dem_set_driven(sim_t *s);
+/* The coupling part (sim_coupling.c): resolved IBM–DEM exchange (ibm != NULL)
+ * and the restitution measurements. */
+void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm);
+void sim_coupling_register_keys(void);
+/* The case has a [fluid] section and [coupling] fluid is not off. */
+int sim_fluid_enabled(cfg_t *cfg);
 
 #endif

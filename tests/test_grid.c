@@ -3,6 +3,7 @@
  * RANKS: 1 2
  */
 #include <stdlib.h>
+#include <string.h>
 
 #include "grid.h"
 #include "poisson.h"
@@ -139,6 +140,35 @@ static double max_trunc_error(const case_t *c, int N)
  * location, including the axisymmetric metric: the interior truncation error
  * must converge at order > 1.8 (2 asymptotically; 1.8 leaves room for the
  * pre-asymptotic range at 64→128). */
+/* uniform_arithmetic (Izard's bouncing-sphere grid): nu equal cells over lu,
+ * then sizes h + k a with a constant increment a, ending exactly at L. */
+static void test_uniform_arithmetic(void **state)
+{
+    (void)state;
+    const int n[3] = {80, 8, 1}, nu = 50;
+    const double L[3] = {10.4, 1, 1}, lu = 2.5;
+    bc_t bc;
+    memset(&bc, 0, sizeof bc);
+    bc.type[0][0] = BC_AXIS;
+    bc.type[0][1] = BC_FREESLIP;
+    bc.type[1][0] = bc.type[1][1] = BC_FREESLIP;
+    grid_t *g = grid_create_uniform_arithmetic(GEOM_AXI, n, L, NULL, &bc, nu, lu, MPI_COMM_WORLD);
+    const double h = lu / nu;
+    double worst_u = 0, worst_a = 0;
+    for (int i = 0; i < nu; i++) worst_u = fmax(worst_u, fabs(g->gdxf[i] - h));
+    const double a = g->gdxf[nu + 1] - g->gdxf[nu];
+    for (int i = nu; i < n[0]; i++) worst_a = fmax(worst_a, fabs(g->gdxf[i] - (h + (i - nu + 1) * a)));
+    printf("uniform_arithmetic: uniform part error %.1e, increment %.5f, arithmetic error %.1e, last face %.15g\n",
+           worst_u, a, worst_a, g->gxf[n[0] - 1]);
+    /* round-off of sums of ~100 terms of size ~1 */
+    assert_true(worst_u < 1e-13 && worst_a < 1e-13);
+    assert_true(fabs(g->gxf[n[0] - 1] - L[0]) < 1e-13);
+    assert_true(a > 0);
+    /* the seed's numbers: 30 cells from 0.05 growing to 0.463 D (reference notes §2.6) */
+    assert_true(fabs(g->gdxf[n[0] - 1] - (h + 30 * a)) < 1e-13 && fabs(h + 30 * a - 0.4628) < 1e-3);
+    grid_free(g);
+}
+
 static void test_operator_consistency(void **state)
 {
     case_t cases[] = {{GEOM_2D, VAR_P, 0}, {GEOM_2D, VAR_U, 0}, {GEOM_2D, VAR_V, 1},
@@ -159,6 +189,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_halo_periodic),
         cmocka_unit_test(test_stretched_geometry),
         cmocka_unit_test(test_operator_consistency),
+        cmocka_unit_test(test_uniform_arithmetic),
     };
     TEST_MPI_RUN("grid", tests);
 }

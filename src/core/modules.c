@@ -18,4 +18,6 @@ void modules_register_keys(void)
     ibm_register_keys();
     sim_register_keys();
     dem_register_keys();
+    dem_lubrication_register_keys();
+    sim_coupling_register_keys();
 }

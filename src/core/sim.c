@@ -1,6 +1,7 @@
 /* sim.c — the run driver (see sim.h): the time loop, the stop conditions,
  * the divergence checks and the schedule of the outputs.  The physics lives
  * in the parts (sim_fluid.c, ...). */
+#include "coupling.h"
 #include "sim.h"
 
 #include <inttypes.h>
@@ -155,12 +156,27 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
     read_params(s, cfg);
 
     /* Parts of the scene, in the order they advance. */
-    if (cfg_has_section(cfg, "fluid")) sim_add_fluid(s, cfg);
-    if (cfg_has_section(cfg, "ibm")) {
-        if (!s->fluid) cfg_fail(cfg, "ibm", "sphere1", "an immersed boundary needs a fluid: the case has no [fluid] section");
-        sim_add_ibm(s, cfg);
+    if (sim_fluid_enabled(cfg)) sim_add_fluid(s, cfg);
+    const int particles = cfg_has_section(cfg, "particles");
+    /* resolved coupling: the particles are immersed spheres of the fluid */
+    const int resolved = s->fluid && particles && !cfg_has_section(cfg, "porenet");
+    if (resolved) {
+        sim_add_dem(s, cfg);
+        sim_dem_set_driven(s);
+        int n = 0;
+        ibm_sphere_t *sp = coupling_spheres_of_particles(sim_dem_engine_unprepared(s), &n);
+        struct ibm *ibm = sim_add_ibm_with(s, cfg, sp, n);
+        free(sp);
+        sim_add_coupling(s, cfg, ibm);
+    } else {
+        if (cfg_has_section(cfg, "ibm")) {
+            if (!s->fluid)
+                cfg_fail(cfg, "ibm", "sphere1", "an immersed boundary needs a fluid: the case has no [fluid] section");
+            sim_add_ibm(s, cfg);
+        }
+        if (particles) sim_add_dem(s, cfg);
+        if (particles && cfg_enum(cfg, "coupling", "restitution") != 0) sim_add_coupling(s, cfg, NULL);
     }
-    if (cfg_has_section(cfg, "particles")) sim_add_dem(s, cfg);
     if (cfg_has_section(cfg, "porenet")) sim_add_porenet(s, cfg);
 
     if (s->npart == 0) {
@@ -273,6 +289,8 @@ static double progress_fraction(const sim_t *s)
 static sim_status_t stop_condition(sim_t *s)
 {
     if (s->time >= s->prm.t_end) return SIM_T_END;
+    for (int i = 0; i < s->npart; i++)
+        if (s->part[i].done && s->part[i].done(s->part[i].ctx)) return SIM_DONE;
     if (s->prm.max_steps > 0 && s->step >= s->prm.max_steps) return SIM_MAX_STEPS;
     if (s->prm.steady_tol > 0 && s->step > s->step0) {
         double rate = 0.0;
@@ -333,7 +351,7 @@ static void outputs(sim_t *s)
 
 static void write_summary(sim_t *s)
 {
-    static const char *status_name[] = {"running", "t_end", "max_steps", "wall_limit", "steady", "diverged"};
+    static const char *status_name[] = {"running", "t_end", "max_steps", "wall_limit", "steady", "diverged", "done"};
     io_summary_t *y = s->summary;
     double wall = wtime() - s->wall0;
     io_summary_string(y, "case", s->prm.name);
@@ -423,7 +441,7 @@ int sim_run(sim_t *s)
     if (s->last_checkpoint_step != s->step) write_checkpoint(s);
     write_summary(s);
     static const char *why[] = {"", "reached t_end", "reached max_steps", "reached the wall-time limit",
-                                "reached a steady state", ""};
+                                "reached a steady state", "", "has what it was run for (a part is done)"};
     double wall = wtime() - s->wall0;
     msg("%s: %s at step %ld, t = %.10g (%ld steps in %.3g s, %.4g steps/s); checkpoint %s\n", s->prm.name,
         why[s->status], s->step, s->time, s->step - s->step0, wall, wall > 0 ? (s->step - s->step0) / wall : 0.0,

@@ -25,6 +25,7 @@ typedef struct {
     int substeps;        /* DEM steps per driver step (DEM-only scene) */
     double rest_after;   /* the rate of change counts after this time */
     int with_fluid;
+    int driven;          /* advanced by the coupling part */
     int prepared;        /* packing prepared, or state read from a checkpoint */
     int snap_first;      /* index of the first snapshot of this run */
     int snap_resumed;
@@ -59,6 +60,7 @@ static void part_advance(void *ctx, double dt)
 {
     dem_part_t *dp = ctx;
     ensure_prepared(dp);
+    if (dp->driven) return;
     const double w0 = wtime();
     const double t_target = dem_time(dp->d) + dt;
     const double steps = ceil(dt / dem_dt(dp->d) * (1 - 1e-12));
@@ -170,6 +172,25 @@ dem_t *sim_dem_engine(sim_t *s)
     return NULL;
 }
 
+static dem_part_t *find_part(sim_t *s)
+{
+    for (int p = 0; p < s->npart; p++)
+        if (!strcmp(s->part[p].name, "dem")) return s->part[p].ctx;
+    return NULL;
+}
+
+void sim_dem_set_driven(sim_t *s)
+{
+    dem_part_t *dp = find_part(s);
+    if (dp) dp->driven = 1;
+}
+
+dem_t *sim_dem_engine_unprepared(sim_t *s)
+{
+    dem_part_t *dp = find_part(s);
+    return dp ? dp->d : NULL;
+}
+
 void sim_add_dem(sim_t *s, cfg_t *cfg)
 {
     dem_part_t *dp = xcalloc(1, sizeof *dp);
@@ -179,7 +200,7 @@ void sim_add_dem(sim_t *s, cfg_t *cfg)
     dp->substeps = cfg_int(cfg, "dem", "substeps");
     dp->rest_after = cfg_double(cfg, "dem", "rest_after");
     /* a fluid (resolved or pore network) sets the step; the DEM sub-cycles in it */
-    dp->with_fluid = cfg_has_section(cfg, "fluid") || cfg_has_section(cfg, "porenet");
+    dp->with_fluid = sim_fluid_enabled(cfg) || cfg_has_section(cfg, "porenet");
     if (dem_count(dp->d) == 0) cfg_fail(cfg, "particles", "source", "the scene has no particles");
     sim_part_t part = {
         .name = "dem",

@@ -354,11 +354,13 @@ static void part_destroy(void *ctx)
     free(ip);
 }
 
-void sim_add_ibm(sim_t *s, cfg_t *cfg)
+void sim_add_ibm(sim_t *s, cfg_t *cfg) { sim_add_ibm_with(s, cfg, NULL, 0); }
+
+struct ibm *sim_add_ibm_with(sim_t *s, cfg_t *cfg, const void *extra, int nextra)
 {
     ibm_part_t *ip = xcalloc(1, sizeof *ip);
     ip->sim = s;
-    ip->ibm = ibm_create_from_config(cfg, s->fluid);
+    ip->ibm = ibm_create_from_config_with(cfg, s->fluid, extra, nextra);
     const grid_t *g = ip->ibm->g;
     ip->nseries = cfg_int(cfg, "ibm", "series_spheres");
     if (ip->nseries > ip->ibm->n) ip->nseries = ip->ibm->n;
@@ -389,4 +391,5 @@ void sim_add_ibm(sim_t *s, cfg_t *cfg)
         .destroy = part_destroy,
     };
     sim_add_part(s, &part);
+    return ip->ibm;
 }

@@ -72,7 +72,7 @@ void dem_grow(dem_t *d, int need)
     int cap = d->cap ? d->cap : 64;
     while (cap < need) cap *= 2;
     const size_t o = (size_t)d->cap, c = (size_t)cap;
-    double **v3[] = {&d->x, &d->v, &d->w, &d->f, &d->t, &d->dv, &d->dw, &d->fext, &d->text};
+    double **v3[] = {&d->x, &d->v, &d->w, &d->f, &d->t, &d->dv, &d->dw, &d->fext, &d->text, &d->flub};
     for (size_t a = 0; a < sizeof v3 / sizeof v3[0]; a++)
         *v3[a] = grow_array(*v3[a], 3 * o * sizeof(double), 3 * c * sizeof(double));
     double **v1[] = {&d->r, &d->invm, &d->invI, &d->rho};
@@ -94,7 +94,7 @@ int dem_add_particle(dem_t *d, const double x[3], const double v[3], double radi
         d->x[3 * i + a] = x[a];
         d->v[3 * i + a] = fixed ? 0.0 : v[a];
         d->w[3 * i + a] = d->f[3 * i + a] = d->t[3 * i + a] = 0.0;
-        d->dv[3 * i + a] = d->dw[3 * i + a] = d->fext[3 * i + a] = d->text[3 * i + a] = 0.0;
+        d->dv[3 * i + a] = d->dw[3 * i + a] = d->fext[3 * i + a] = d->text[3 * i + a] = d->flub[3 * i + a] = 0.0;
     }
     d->r[i] = radius;
     d->rho[i] = density;
@@ -137,7 +137,7 @@ void dem_free(dem_t *d)
 {
     if (!d) return;
     dem_neigh_free(d);
-    void *arr[] = {d->x, d->v, d->w, d->f, d->t, d->dv, d->dw, d->fext, d->text,
+    void *arr[] = {d->x, d->v, d->w, d->f, d->t, d->dv, d->dw, d->fext, d->text, d->flub,
                    d->r, d->invm, d->invI, d->rho, d->id, d->fixed};
     for (size_t a = 0; a < sizeof arr / sizeof arr[0]; a++) free(arr[a]);
     free(d->kernel_block);
@@ -192,7 +192,13 @@ void dem_check_scene(dem_t *d)
         dmean += 2 * d->r[i];
     }
     d->rmax = rmax;
-    if (d->skin_rel > 0) d->skin = d->skin_rel * 2 * rmax;
+    /* lubrication: the lists also hold every pair within Δ_lub (lubrication.c) */
+    d->lub.reach = d->lub.on ? d->lub.range * rmax : 0.0;
+    if (d->skin_rel > 0)
+        d->skin = d->skin_rel * 2 * rmax + d->lub.reach;
+    else
+        d->skin += d->lub.reach - d->skin_lub_added;
+    d->skin_lub_added = d->lub.reach;
     for (int a = 0; a < 3; a++)
         if (d->periodic[a] && d->L[a] < 4 * rmax)
             die("dem: the periodic length in %c (%g m) must be at least twice the largest diameter (%g m)", "xyz"[a],
@@ -269,7 +275,7 @@ void dem_compute_forces(dem_t *d)
  * step fused in); returns max |v|² over the mobile particles. */
 static double kick_drift(dem_t *d)
 {
-    const double dt = d->dt, h = 0.5 * dt;
+    const double dt = d->lub.on ? 0.0 : d->dt, h = 0.5 * d->dt; /* lubrication: drift after its impulses */
     const double gx = d->gravity[0], gy = d->gravity[1], gz = d->gravity[2];
     const double kick = d->pending_kick ? 2.0 : 1.0; /* closing kick of the last step + opening kick */
     double *restrict x = d->x, *restrict v = d->v, *restrict w = d->w, *restrict dv = d->dv, *restrict dw = d->dw;
@@ -326,6 +332,20 @@ static double kick_drift(dem_t *d)
         }
     }
     d->pending_kick = 1;
+    if (d->lub.on) {
+        /* the lubrication impulses of this drift (implicit in the gap it produces), then the drift */
+        dem_lubrication_impulses(d, d->dt);
+        vmax2 = 0.0;
+        for (int i = 0; i < n; i++) {
+            if (fixed[i]) continue;
+            double v2 = 0;
+            for (int c = 0; c < 3; c++) {
+                x[3 * i + c] += d->dt * v[3 * i + c];
+                v2 += v[3 * i + c] * v[3 * i + c];
+            }
+            if (v2 > vmax2) vmax2 = v2;
+        }
+    }
     return vmax2;
 }
 
@@ -414,11 +434,28 @@ static dem_status_t step_once(dem_t *d)
         }
     }
     d->t_integ += wtime() - t0;
-    if (d->disp_bound + wmoved > 0.5 * d->skin) {
+    if (d->disp_bound + wmoved > 0.5 * (d->skin - d->lub.reach)) {
         if ((st = dem_neigh_build(d)) != DEM_OK) return st;
     }
     dem_compute_forces(d);
+    if (d->observer) d->observer(d, d->observer_ctx);
     return overlap_check(d);
+}
+
+void dem_full_velocity(const dem_t *d, int i, double vel[3])
+{
+    const double h = d->pending_kick ? 0.5 * d->dt : 0.0;
+    for (int c = 0; c < 3; c++) {
+        double fa = d->f[3 * i + c];
+        if (d->use_ext) fa += d->fext[3 * i + c];
+        vel[c] = d->v[3 * i + c] + (d->fixed[i] ? 0.0 : h * (fa * d->invm[i] + d->gravity[c]));
+    }
+}
+
+void dem_set_step_observer(dem_t *d, void (*fn)(dem_t *d, void *ctx), void *ctx)
+{
+    d->observer = fn;
+    d->observer_ctx = ctx;
 }
 
 dem_status_t dem_step(dem_t *d)
@@ -474,6 +511,8 @@ double dem_dt(const dem_t *d) { return d->dt; }
 double dem_time(const dem_t *d) { return d->time; }
 double dem_contact_time(const dem_t *d) { return d->tc; }
 void dem_set_time(dem_t *d, double t) { d->time = t; }
+void dem_get_gravity(const dem_t *d, double g[3]) { memcpy(g, d->gravity, 3 * sizeof(double)); }
+double dem_dry_restitution(const dem_t *d) { return d->cp.restitution; }
 void dem_set_gravity(dem_t *d, const double g[3])
 {
     dem_sync_velocities(d);
@@ -600,4 +639,43 @@ void dem_diag_light(dem_t *d, dem_diag_t *o)
     o->rebuilds = d->rebuilds;
     o->contacts_started = d->n_starts;
     if (d->split) MPI_Allreduce(MPI_IN_PLACE, &o->contacts_started, 1, MPI_LONG, MPI_SUM, d->comm);
+}
+
+double dem_time_to_contact(const dem_t *d)
+{
+    /* pairs from the neighbour lists (every pair that can touch before the next rebuild),
+     * walls directly; the relative velocity is held */
+    double tmin = INFINITY;
+    const double *x = d->x, *v = d->v, *r = d->r;
+    if (d->nb_start)
+        for (int i = 0; i < d->nb_n_rows; i++)
+            for (long e = d->nb_start[i]; e < d->nb_start[i + 1]; e++) {
+                const int j = d->nb_j[e];
+                const double *sh = d->any_periodic ? d->shift[d->nb_img[e]] : d->shift[13];
+                double n[3], dist2 = 0, u = 0;
+                for (int a = 0; a < 3; a++) {
+                    n[a] = x[3 * j + a] + sh[a] - x[3 * i + a];
+                    dist2 += n[a] * n[a];
+                }
+                const double dist = sqrt(dist2), gap = dist - r[i] - r[j];
+                if (gap <= 0) return 0.0;
+                for (int a = 0; a < 3; a++) u += (v[3 * i + a] - v[3 * j + a]) * n[a] / dist;
+                if (u > 0 && gap / u < tmin) tmin = gap / u;
+            }
+    for (int w = 0; w < d->nwall; w++) {
+        const dem_wall_t *W = &d->wall[w];
+        if (!W->active) continue;
+        for (int i = 0; i < d->n; i++) {
+            if (d->fixed[i]) continue;
+            double s = 0, u = 0;
+            for (int a = 0; a < 3; a++) {
+                s += (x[3 * i + a] - W->p[a]) * W->n[a];
+                u -= (v[3 * i + a] - W->vel[a]) * W->n[a];
+            }
+            const double gap = s - r[i];
+            if (gap <= 0) return 0.0;
+            if (u > 0 && gap / u < tmin) tmin = gap / u;
+        }
+    }
+    return tmin;
 }

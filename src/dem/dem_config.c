@@ -20,7 +20,14 @@
 
 static const cfg_key_t dem_keys[] = {
     /* [particles] */
-    {"particles", "source", CFG_ENUM, "none", 1, 0, "none|insert|file|lammps_data",
+#define PARTICLE_KEY(N)                                                                                         \
+    {"particles", "particle" #N, CFG_STRING, NULL, 1, 0, NULL,                                                   \
+     "source = list: one particle, tagged values in any order: center X Y Z; radius R (or diameter D); "          \
+     "density RHO (default particles.density); velocity U V W; omega WX WY WZ; fixed. "                           \
+     "Example: center 0 10 0 diameter 1 density 8"}
+    PARTICLE_KEY(1), PARTICLE_KEY(2), PARTICLE_KEY(3), PARTICLE_KEY(4), PARTICLE_KEY(5), PARTICLE_KEY(6),
+    PARTICLE_KEY(7), PARTICLE_KEY(8), PARTICLE_KEY(9),
+    {"particles", "source", CFG_ENUM, "none", 1, 0, "none|insert|file|lammps_data|list",
      "where the particles come from: none (added by a program), random insertion, an HDF5 packing or "
      "checkpoint (file), a LAMMPS data file (lammps_data)"},
     {"particles", "file", CFG_STRING, NULL, 1, 0, NULL, "HDF5 packing/checkpoint or LAMMPS data file to read"},
@@ -142,8 +149,11 @@ static void config_walls(dem_t *d, cfg_t *cfg)
     }
     for (int a = 0; a < 3; a++)
         for (int s = 0; s < 2; s++) {
-            const int want = autow ? !d->periodic[a] : (!none && has_word(faces, face_names[a][s]));
+            const int want = autow ? !d->periodic[a] && !(d->axisymmetric && a != 1)
+                                   : (!none && has_word(faces, face_names[a][s]));
             if (!want) continue;
+            if (d->axisymmetric && a != 1)
+                cfg_fail(cfg, "walls", "faces", "axisymmetric scene: walls only on the y faces (the spheres stay on the axis)");
             if (d->periodic[a])
                 cfg_fail(cfg, "walls", "faces", "face %s is periodic and cannot carry a wall", face_names[a][s]);
             double p[3] = {d->lo[0], d->lo[1], d->lo[2]}, n[3] = {0, 0, 0};
@@ -278,6 +288,44 @@ void dem_freeze_below(dem_t *d, cfg_t *cfg)
     msg("dem: %d particles below %c = %g m are now fixed (rough bed)\n", nf, "xyz"[ax], h);
 }
 
+/* One particle of source = list: "center X Y Z diameter D density RHO ...". */
+static void config_list_particle(dem_t *d, cfg_t *cfg, const char *key)
+{
+    char buf[1024];
+    snprintf(buf, sizeof buf, "%s", cfg_string(cfg, "particles", key));
+    double x[3] = {0, 0, 0}, v[3] = {0, 0, 0}, w[3] = {0, 0, 0}, r = -1, rho = cfg_double(cfg, "particles", "density");
+    int have_x = 0, fixed = 0;
+    char *save = NULL;
+    for (char *tok = strtok_r(buf, " \t,", &save); tok; tok = strtok_r(NULL, " \t,", &save)) {
+        int nv = 0, diam = 0;
+        double *dst = NULL;
+        if (!strcmp(tok, "center") || !strcmp(tok, "centre") || !strcmp(tok, "position")) nv = 3, dst = x, have_x = 1;
+        else if (!strcmp(tok, "radius")) nv = 1, dst = &r;
+        else if (!strcmp(tok, "diameter")) nv = 1, dst = &r, diam = 1;
+        else if (!strcmp(tok, "density")) nv = 1, dst = &rho;
+        else if (!strcmp(tok, "velocity")) nv = 3, dst = v;
+        else if (!strcmp(tok, "omega")) nv = 3, dst = w;
+        else if (!strcmp(tok, "fixed")) fixed = 1;
+        else cfg_fail(cfg, "particles", key, "'%s' is not one of center, radius, diameter, density, velocity, omega, fixed", tok);
+        for (int i = 0; i < nv; i++) {
+            char *t = strtok_r(NULL, " \t,", &save), *end;
+            if (!t) cfg_fail(cfg, "particles", key, "%s needs %d number%s", tok, nv, nv > 1 ? "s" : "");
+            dst[i] = strtod(t, &end);
+            if (*end || !isfinite(dst[i])) cfg_fail(cfg, "particles", key, "%s: '%s' is not a number", tok, t);
+        }
+        if (diam) r *= 0.5;
+    }
+    if (!have_x) cfg_fail(cfg, "particles", key, "no center X Y Z");
+    if (!(r > 0)) cfg_fail(cfg, "particles", key, "no positive radius R (or diameter D)");
+    if (!(rho > 0)) cfg_fail(cfg, "particles", key, "the density must be positive");
+    for (int a = 0; a < 3; a++)
+        if (!d->periodic[a] && (x[a] - r < d->lo[a] || x[a] + r > d->hi[a]) && !(d->axisymmetric && a != 1))
+            cfg_fail(cfg, "particles", key, "the particle (centre %g %g %g, radius %g) does not fit the domain", x[0], x[1],
+                     x[2], r);
+    const int i = dem_add_particle(d, x, v, r, rho, fixed);
+    dem_set_omega(d, d->id[i], w);
+}
+
 void dem_config_particles(dem_t *d, cfg_t *cfg)
 {
     const int source = cfg_enum(cfg, "particles", "source");
@@ -308,7 +356,22 @@ void dem_config_particles(dem_t *d, cfg_t *cfg)
     } else if (source == 3) {
         double blo[3], bhi[3];
         dem_read_lammps_data(d, cfg_string(cfg, "particles", "file"), blo, bhi, 0);
+    } else if (source == 4) {
+        int count = 0;
+        for (int k = 1; k <= 9; k++) {
+            char key[16];
+            snprintf(key, sizeof key, "particle%d", k);
+            if (!cfg_has(cfg, "particles", key)) continue;
+            config_list_particle(d, cfg, key);
+            count++;
+        }
+        if (!count) cfg_fail(cfg, "particles", "source", "list: no particle1 ... particle9 key");
     }
+    if (d->axisymmetric)
+        for (int i = 0; i < d->n; i++)
+            if (d->x[3 * i] != 0 || d->x[3 * i + 2] != 0 || d->v[3 * i] != 0 || d->v[3 * i + 2] != 0)
+                cfg_fail(cfg, "particles", "source",
+                         "axisymmetric scene: every particle must lie and move on the axis (x = z = 0, u = w = 0)");
 }
 
 /* Random sequential insertion in [lo, hi] (centres at least R from the
@@ -480,8 +543,11 @@ dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
     d->comm = comm;
     MPI_Comm_rank(comm, &d->rank);
     MPI_Comm_size(comm, &d->nranks);
-    if (cfg_enum(cfg, "domain", "geometry") != 0)
-        cfg_fail(cfg, "domain", "geometry", "the DEM (spheres) needs geometry = 3d");
+    const int geometry = cfg_enum(cfg, "domain", "geometry");
+    if (geometry == 1) cfg_fail(cfg, "domain", "geometry", "the DEM (spheres) needs geometry = 3d or axisymmetric");
+    /* axisymmetric (x = r, y = axial): spheres on the axis, in a 3-D box
+     * [−r_max, r_max] × y × [−r_max, r_max] with walls only on the y faces */
+    d->axisymmetric = geometry == 2;
     const int source = cfg_enum(cfg, "particles", "source");
     double L[3], o[3];
     if (source == 3 && !cfg_has(cfg, "domain", "length")) {
@@ -496,11 +562,16 @@ dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
         cfg_vec3(cfg, "domain", "length", L);
         cfg_vec3(cfg, "domain", "origin", o);
     }
+    if (d->axisymmetric) {
+        L[2] = L[0] = 2 * (o[0] + L[0]);
+        o[2] = o[0] = -0.5 * L[0];
+    }
     for (int a = 0; a < 3; a++) {
         if (!(L[a] > 0)) cfg_fail(cfg, "domain", "length", "every component must be positive");
         d->lo[a] = o[a];
         d->L[a] = L[a];
         d->hi[a] = o[a] + L[a];
+        if (d->axisymmetric && a != 1) continue;
         const int plo = cfg_enum(cfg, "boundary", face_names[a][0]) == 0,
                   phi = cfg_enum(cfg, "boundary", face_names[a][1]) == 0;
         if (plo != phi)
@@ -532,6 +603,7 @@ dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
     if (d->nthreads > 1) cfg_fail(cfg, "dem", "threads", "this build has no OpenMP (compile src/dem with -fopenmp)");
 #endif
     d->hist_update = 1;
+    dem_lubrication_config(d, cfg);
     config_walls(d, cfg);
     const int src = cfg_enum(cfg, "particles", "source");
     if (src == 2 && cfg_enum(cfg, "bed", "type") != 0)

@@ -160,7 +160,7 @@ static void permute_particles(dem_t *d, const int *order)
 {
     const int n = d->n;
     double *tmp = malloc((size_t)(3 * n + 1) * sizeof(double));
-    double *v3[] = {d->x, d->v, d->w, d->f, d->t, d->dv, d->dw, d->fext, d->text};
+    double *v3[] = {d->x, d->v, d->w, d->f, d->t, d->dv, d->dw, d->fext, d->text, d->flub};
     for (size_t a = 0; a < sizeof v3 / sizeof v3[0]; a++) permute_d(v3[a], order, n, 3, tmp);
     double *v1[] = {d->r, d->invm, d->invI, d->rho};
     for (size_t a = 0; a < sizeof v1 / sizeof v1[0]; a++) permute_d(v1[a], order, n, 1, tmp);

@@ -34,6 +34,23 @@ typedef struct {
     double force[3]; /* force exerted by the particles on the wall, last step */
 } dem_wall_t;
 
+/* Brenner (1961) normal lubrication with an effective roughness (Izard eq.
+ * 2.36/3.18, decision 5; lubrication.c): between particles and between a
+ * particle and a wall, active for 0 < δ_n ≤ Δ_lub, off while they overlap. */
+typedef struct {
+    int on;
+    int walls;           /* also between a particle and a wall */
+    int subtract;        /* subtract the force at δ_n = Δ_lub (the part the grid resolves) */
+    double viscosity;    /* η_f (Pa s) */
+    double roughness;    /* η_e / R */
+    double range;        /* Δ_lub / R */
+    double reach;        /* largest Δ_lub among the particles (m): margin of the lists */
+    long active;         /* pairs and walls that exchanged a lubrication impulse in the last step */
+} dem_lub_t;
+
+/* Called after every DEM step (dem_set_step_observer). */
+typedef void (*dem_step_observer_t)(dem_t *d, void *ctx);
+
 /* Contact parameters: the common part (tangential spring, friction, rolling)
  * and the fields of each law.  Laws read what they need in setup(). */
 typedef struct {
@@ -81,6 +98,7 @@ struct dem {
     double *dv, *dw;     /* dt/2 × acceleration of the previous step (predictor) */
     double *fext, *text; /* external force and torque (immersed boundary) */
     double *fc;          /* contact force of the last step (diagnostics), 3n */
+    double *flub;        /* lubrication force of the last step (impulse / dt), 3n */
     double *r, *invm, *invI, *rho;
     long *id;
     unsigned char *fixed;
@@ -91,10 +109,16 @@ struct dem {
     double lo[3], hi[3], L[3];
     int periodic[3];
     int any_periodic;
+    int axisymmetric;    /* the fluid is axisymmetric: spheres on the y axis (x = z = 0) */
 
     /* walls */
     int nwall;
     dem_wall_t wall[DEM_MAX_WALLS];
+
+    /* lubrication */
+    dem_lub_t lub;
+    dem_step_observer_t observer;
+    void *observer_ctx;
 
     /* contact law */
     const dem_contact_law_t *law;
@@ -114,6 +138,7 @@ struct dem {
     /* neighbour search: linked cells + Verlet list with skin */
     double skin;         /* absolute skin (m) */
     double skin_rel;     /* skin as a fraction of the largest diameter */
+    double skin_lub_added; /* part of skin added for the lubrication range (lub.reach) */
     double rmax;
     int nc[3];
     double csize[3];
@@ -190,6 +215,13 @@ int dem_insert_random(dem_t *d, const double lo[3], const double hi[3], long cou
 void dem_read_lammps_data(dem_t *d, const char *path, double box_lo[3], double box_hi[3], int read_box);
 void dem_add_wall(dem_t *d, const char *name, const double p[3], const double n[3], const double vel[3],
                   double remove_time);
+
+/* ---- lubrication (lubrication.c) ---- */
+/* Read [lubrication] (viscosity default: ρν of [fluid]). */
+void dem_lubrication_config(dem_t *d, cfg_t *cfg);
+/* Apply the lubrication impulses of the coming drift of length dt to the
+ * half-step velocities (implicit in the gap, see lubrication.c). */
+void dem_lubrication_impulses(dem_t *d, double dt);
 
 /* Small deterministic random generator (splitmix64 / xoshiro256**). */
 typedef struct {

@@ -15,8 +15,11 @@ static const cfg_key_t grid_keys[] = {
     {"domain", "nz", CFG_INT, "1", 1, 1 << 20, NULL, "cells in z (must be 1 in 2d and axisymmetric)"},
     {"domain", "length", CFG_VEC3, NULL, 1e-300, 1e300, NULL, "domain size Lx Ly Lz (Lz ignored in 2-D)"},
     {"domain", "origin", CFG_VEC3, "0 0 0", -1e300, 1e300, NULL, "low corner of the domain (x must be 0 when axisymmetric)"},
-    {"domain", "x_stretch", CFG_ENUM, "uniform", 1, 0, "uniform|tanh_low|tanh_high|tanh_both",
-     "spacing in x: uniform, or tanh clustering at the low, high or both x faces"},
+    {"domain", "x_stretch", CFG_ENUM, "uniform", 1, 0, "uniform|tanh_low|tanh_high|tanh_both|uniform_arithmetic",
+     "spacing in x: uniform, tanh clustering at the low, high or both x faces, or uniform_arithmetic (uniform "
+     "from the low face over x_uniform_length in x_uniform_cells cells, then growing in arithmetic progression)"},
+    {"domain", "x_uniform_cells", CFG_INT, "0", 1, 1 << 20, NULL, "uniform_arithmetic: cells of the uniform part"},
+    {"domain", "x_uniform_length", CFG_DOUBLE, "0", 0, 1e300, NULL, "uniform_arithmetic: length of the uniform part"},
     {"domain", "x_stretch_beta", CFG_DOUBLE, "2.0", 1e-6, 20, NULL, "strength of the tanh clustering"},
 #define FACE_KEYS(F)                                                                                        \
     {"boundary", F, CFG_ENUM, "periodic", 1, 0, "periodic|noslip|freeslip|axis",                             \
@@ -91,6 +94,19 @@ grid_t *grid_create_from_config(cfg_t *cfg, MPI_Comm comm)
         cfg_fail(cfg, "domain", "nx", "%d cells do not divide among %d ranks (slabs in x)", n[0], nranks);
     if (n[0] / nranks < 2)
         cfg_fail(cfg, "domain", "nx", "%d cells among %d ranks leaves fewer than 2 per rank", n[0], nranks);
+    if (st == STRETCH_UNIFORM_ARITHMETIC) {
+        const int nu = cfg_int(cfg, "domain", "x_uniform_cells");
+        const double lu = cfg_double(cfg, "domain", "x_uniform_length");
+        if (nu < 1 || nu >= n[0]) cfg_fail(cfg, "domain", "x_uniform_cells", "must be between 1 and nx - 1 (got %d)", nu);
+        if (!(lu > 0) || lu >= L[0]) cfg_fail(cfg, "domain", "x_uniform_length", "must be in (0, Lx) (got %g)", lu);
+        const int m = n[0] - nu;
+        const double h = lu / nu, a = 2 * (L[0] - lu - m * h) / ((double)m * (m + 1));
+        if (a < 0)
+            cfg_fail(cfg, "domain", "x_uniform_cells",
+                     "the stretched part would shrink: %d cells of %g leave %g for %d cells (lower nx or the uniform size)",
+                     nu, h, L[0] - lu, m);
+        return grid_create_uniform_arithmetic(geom, n, L, x0, &bc, nu, lu, comm);
+    }
     return grid_create(geom, n, L, x0, &bc, st, beta, comm);
 }
 
@@ -103,12 +119,39 @@ static double stretch_map(stretch_t st, double beta, double s)
     case STRETCH_TANH_LOW: return 1.0 + tanh(beta * (s - 1.0)) / tanh(beta);
     case STRETCH_TANH_HIGH: return tanh(beta * s) / tanh(beta);
     case STRETCH_TANH_BOTH: return 0.5 * (1.0 + tanh(beta * (s - 0.5)) / tanh(0.5 * beta));
+    case STRETCH_UNIFORM_ARITHMETIC: break; /* uniform_arithmetic_face */
     }
     return s;
 }
 
+static grid_t *grid_build(geom_t geom, const int n[3], const double L[3], const double x0[3], const bc_t *bc,
+                          stretch_t stretch, double beta, int nu, double lu, MPI_Comm comm);
+
 grid_t *grid_create(geom_t geom, const int n[3], const double L[3], const double x0[3], const bc_t *bc,
                     stretch_t stretch, double beta, MPI_Comm comm)
+{
+    return grid_build(geom, n, L, x0, bc, stretch, beta, 0, 0.0, comm);
+}
+
+grid_t *grid_create_uniform_arithmetic(geom_t geom, const int n[3], const double L[3], const double x0[3], const bc_t *bc,
+                                       int nu, double lu, MPI_Comm comm)
+{
+    return grid_build(geom, n, L, x0, bc, STRETCH_UNIFORM_ARITHMETIC, 0.0, nu, lu, comm);
+}
+
+/* Face i (0..n) of the uniform_arithmetic spacing, as a fraction of L:
+ * nu cells of h = lu/nu, then h + k a (k = 1..m), a = 2(L − lu − m h)/(m(m+1)). */
+static double uniform_arithmetic_face(int i, int n, int nu, double lu, double L)
+{
+    const int m = n - nu;
+    const double h = lu / nu, a = 2 * (L - lu - m * h) / ((double)m * (m + 1));
+    if (i <= nu) return i * h / L;
+    const int k = i - nu;
+    return (lu + k * h + a * k * (k + 1) / 2.0) / L;
+}
+
+static grid_t *grid_build(geom_t geom, const int n[3], const double L[3], const double x0[3], const bc_t *bc,
+                          stretch_t stretch, double beta, int nu, double lu, MPI_Comm comm)
 {
     grid_t *g = xcalloc(1, sizeof *g);
     g->geom = geom;
@@ -153,7 +196,12 @@ grid_t *grid_create(geom_t geom, const int n[3], const double L[3], const double
     g->gxc = buf + (nx + 2) + 1;
     g->gdxf = buf + 2 * (nx + 2) + 1;
     g->gdxc = buf + 3 * (nx + 2) + 1;
-    for (int i = -1; i < nx; i++) g->gxf[i] = g->x0[0] + g->L[0] * stretch_map(stretch, beta, (double)(i + 1) / nx);
+    g->stretch_uniform_cells = nu;
+    g->stretch_uniform_length = lu;
+    for (int i = -1; i < nx; i++)
+        g->gxf[i] = g->x0[0] + g->L[0] * (stretch == STRETCH_UNIFORM_ARITHMETIC
+                                              ? uniform_arithmetic_face(i + 1, nx, nu, lu, g->L[0])
+                                              : stretch_map(stretch, beta, (double)(i + 1) / nx));
     g->gxf[-1] = g->x0[0];
     g->gxf[nx - 1] = g->x0[0] + g->L[0];
     /* Ghost face beyond the high boundary: mirror of the last cell. */

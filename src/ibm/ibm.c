@@ -476,7 +476,9 @@ static double *read_history(cfg_t *cfg, const char *key, const char *path, int *
     return rows;
 }
 
-ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f)
+ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f) { return ibm_create_from_config_with(cfg, f, NULL, 0); }
+
+ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *extra, int nextra)
 {
     const grid_t *g = f->g;
     ibm_params_t prm = ibm_default_params();
@@ -528,6 +530,15 @@ ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f)
             const char *why = sphere_misfit(g, &s[p]);
             if (why) cfg_fail(cfg, "ibm", "spheres_file", "sphere %d of %s: %s", p - n0 + 1, path, why);
         }
+    }
+    if (nextra > 0) {
+        s = realloc(s, (size_t)(n + nextra) * sizeof *s);
+        for (int p = 0; p < nextra; p++) {
+            s[n + p] = extra[p];
+            const char *why = sphere_misfit(g, &s[n + p]);
+            if (why) cfg_fail(cfg, "particles", "source", "particle %d as an immersed sphere: %s", p, why);
+        }
+        n += nextra;
     }
     if (n == 0) cfg_fail(cfg, "ibm", "sphere1", "the [ibm] section defines no sphere (sphere1.. or spheres_file)");
     /* along a periodic direction a sphere and its band must fit in the period */

@@ -1,0 +1,77 @@
+/* coupling.h — the resolved fluid–particle coupling (immersed boundary ↔
+ * DEM, Izard 2014 §1.8 of the reference notes) and the restitution
+ * measurements of the bouncing cases (§2.6, §2.9; decision 8).
+ *
+ * One fluid step (docs/theory.md §9):
+ *   1. the fluid advances Δt_f with every particle as an immersed sphere held
+ *      at its position and forced to its rigid-body velocity (ibm.h, kind
+ *      external), which gives the hydrodynamic force F_h and torque T_h
+ *      (averages over the three RK stages);
+ *   2. the DEM advances the same Δt_f in M = ⌈Δt_f/Δt_s⌉ equal sub-steps
+ *      (Δt_s = t_c/n_c, set by the contact time, not by the fluid step), with
+ *      F_h − ρV_p g and T_h held constant and the contact and lubrication
+ *      forces evaluated at every sub-step;
+ *   3. the new positions and velocities go back to the immersed boundary,
+ *      which rebuilds its solid fraction for the next step.
+ *
+ * The restitution tracker follows one particle against a wall (or a pair of
+ * particles) through its first collision, from the fluid-step samples and
+ * the DEM sub-steps (restitution.c).
+ */
+#ifndef IBMDEM_COUPLING_H
+#define IBMDEM_COUPLING_H
+
+#include "dem.h"
+#include "ibm.h"
+
+/* ---- exchange (ibm_dem.c) ---------------------------------------------------- */
+
+/* The immersed spheres of the DEM particles: kind external, in the order of
+ * the particles' ids (sphere p is the particle of id p).  *n gets the count;
+ * the array is malloc'd. */
+ibm_sphere_t *coupling_spheres_of_particles(const dem_t *d, int *n);
+/* Step 1 → 2: hand the hydrodynamic force and torque of the last fluid step,
+ * with the buoyancy −ρ V_p g, to the DEM as its external force and torque. */
+void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3]);
+/* Step 2 → 3: positions and velocities of the particles to the spheres, and
+ * the solid fraction rebuilt (collective). */
+void coupling_motion_to_ibm(const dem_t *d, ibm_t *ibm);
+
+/* ---- restitution (restitution.c) ---------------------------------------------- */
+
+typedef enum { RESTITUTION_OFF = 0, RESTITUTION_WALL = 1, RESTITUTION_PAIR = 2 } restitution_mode_t;
+
+typedef struct {
+    restitution_mode_t mode;
+    double axis[3];      /* wall: unit vector towards the wall (along gravity) */
+    double rho_f, mu;    /* fluid density and viscosity (St, Re); mu = 0: dry */
+    double rho_p, D;     /* particle density and diameter (the particle of id 0) */
+    double e_dry;        /* ε_max of the contact law */
+    /* state */
+    int phase;           /* 0 approach, 1 first contact, 2 after it, 3 a second contact seen */
+    double u_last;       /* approach speed at the last sub-step */
+    double VT, VC, VR;   /* approach speed before the contact (max over the fluid steps), at the
+                          * last fluid step before the contact, largest rebound speed after it (fluid steps) */
+    double VC_onset;     /* approach speed at the last sub-step before the contact starts */
+    double VR_release;   /* rebound speed when the contact ends (sub-step) */
+    double t_contact, t_release;
+    double lub_impulse;  /* lubrication impulse on the particle along the axis in the last fluid step */
+} restitution_t;
+
+/* axis: wall mode: unit vector from the particle towards the wall. */
+void restitution_init(restitution_t *r, restitution_mode_t mode, const double axis[3], double rho_f, double mu,
+                      double rho_p, double D, double e_dry);
+/* After every DEM sub-step (an observer, dem_set_step_observer). */
+void restitution_substep(restitution_t *r, dem_t *d);
+/* After every fluid step (or driver step of a dry run). */
+void restitution_sample(restitution_t *r, dem_t *d, double time);
+/* Approach speed of the tracked motion now (wall: v·axis; pair: (v₀ − v₁)·n₀₁). */
+double restitution_approach_speed(const restitution_t *r, dem_t *d, int full_step);
+/* Results: ε = V_R/V_T, St = (ρ_p + ρ/2) V_T D/(9μ) and Re_p = ρ V_T D/μ
+ * (wall, eq. 3.19), or ε_B and St_B = ρ_p U D/(9μ), Re = ρ U D/μ (pair,
+ * eq. 3.34–3.35, no added mass). */
+double restitution_epsilon(const restitution_t *r);
+double restitution_stokes(const restitution_t *r);
+double restitution_reynolds(const restitution_t *r);
+
+#endif

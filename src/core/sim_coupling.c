@@ -1,0 +1,269 @@
+/* sim_coupling.c — the resolved fluid–particle coupling as a part of a run
+ * (sim.h, coupling.h), and the restitution measurement of bouncing cases.
+ *
+ * Built when the scene has a fluid and particles (without a pore network):
+ * every particle becomes an immersed sphere of kind external; after the
+ * fluid step (which forced the spheres where they were) this part hands the
+ * hydrodynamic forces to the DEM, advances the DEM over the fluid step with
+ * its own sub-steps (the DEM part is then driven from here), and moves the
+ * spheres.  [coupling] fluid = off ignores the [fluid] section: a dry DEM
+ * run (lubrication still acts if [lubrication] model = brenner, with its
+ * viscosity).  [coupling] restitution = wall|pair adds the bounce
+ * measurements (restitution.c) to the time series and summary.json, in
+ * coupled and dry runs alike.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "coupling.h"
+#include "sim.h"
+#include "util.h"
+
+static const cfg_key_t coupling_keys[] = {
+    {"coupling", "fluid", CFG_ENUM, "resolved", 1, 0, "resolved|off",
+     "resolved: particles are immersed spheres of the [fluid] (DEM sub-cycled in each fluid step); "
+     "off: ignore [fluid], dry DEM (with [lubrication] if set)"},
+    {"coupling", "restitution", CFG_ENUM, "off", 1, 0, "off|wall|pair",
+     "measure a bounce: particle 0 against a wall (V_T, V_C, V_R, epsilon, St, Re_p) or particles 0 and 1 (epsilon_B, St_B)"},
+    {"coupling", "stop_after_rebound", CFG_BOOL, "false", 1, 0, NULL,
+     "restitution: stop the run once the bounce is measured (the particle moves towards the wall again, touches "
+     "it a second time, rests on it, or stopped before touching it)"},
+    {"coupling", "align_contacts", CFG_BOOL, "false", 1, 0, NULL,
+     "end a fluid step where a contact is predicted to start (steps not shorter than t_c/4), so that "
+     "collisions start at the beginning of a fluid step"},
+    {"coupling", "restitution_axis", CFG_VEC3, NULL, -1e300, 1e300, NULL,
+     "wall: direction from the particle towards the wall (default: along gravity)"},
+    {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
+};
+
+void sim_coupling_register_keys(void) { cfg_schema_add(coupling_keys); }
+
+int sim_fluid_enabled(cfg_t *cfg) { return cfg_has_section(cfg, "fluid") && cfg_enum(cfg, "coupling", "fluid") == 0; }
+
+typedef struct {
+    sim_t *sim;
+    cfg_t *cfg;
+    dem_t *d;
+    ibm_t *ibm;          /* NULL in a dry run */
+    double rho_f, gravity[3];
+    int synced;
+    restitution_t rest;
+    dem_status_t status;
+    int stop_after;      /* [coupling] stop_after_rebound */
+    int align;           /* [coupling] align_contacts */
+    double wall_dem;     /* wall time in the DEM */
+    long substeps;       /* DEM sub-steps done */
+} coupling_part_t;
+
+static const char *const rest_cols[] = {"approach_speed", "lubrication_force"};
+
+static void observe(dem_t *d, void *ctx)
+{
+    coupling_part_t *cp = ctx;
+    restitution_substep(&cp->rest, d);
+    cp->substeps++;
+}
+
+/* Density, diameter and ε_max of the tracked particle (id 0). */
+static void tracked_particle(coupling_part_t *cp)
+{
+    const long *id = dem_ids(cp->d);
+    for (int i = 0; i < dem_count(cp->d); i++)
+        if (id[i] == 0) {
+            const double r = dem_radii(cp->d)[i];
+            cp->rest.rho_p = dem_mass(cp->d, i) / (4.0 / 3.0 * M_PI * r * r * r);
+            cp->rest.D = 2 * r;
+        }
+    cp->rest.e_dry = dem_dry_restitution(cp->d);
+}
+
+/* The DEM engine, prepared, and the spheres at its particles (once). */
+static void setup(coupling_part_t *cp)
+{
+    if (cp->synced) return;
+    cp->synced = 1;
+    cp->d = sim_dem_engine(cp->sim);
+    tracked_particle(cp);
+    dem_get_gravity(cp->d, cp->gravity);
+    if (cp->rest.mode != RESTITUTION_OFF) dem_set_step_observer(cp->d, observe, cp);
+    if (cp->ibm) {
+        if (dem_count(cp->d) != cp->ibm->n) die("coupling: %d particles but %d immersed spheres", dem_count(cp->d), cp->ibm->n);
+        memcpy(cp->ibm->prm.gravity, cp->gravity, sizeof cp->gravity);
+        if (cp->sim->step == 0) coupling_motion_to_ibm(cp->d, cp->ibm); /* after the packing preparation */
+    }
+}
+
+/* align_contacts: the step ends where the next contact is predicted to
+ * start (at the current velocities), unless that is less than t_c/4 away; the
+ * lubrication slows the approach, so a few steps may be cut before the contact. */
+static double part_stable_dt(void *ctx)
+{
+    coupling_part_t *cp = ctx;
+    setup(cp);
+    if (!cp->ibm || !cp->align) return INFINITY;
+    const double t = dem_time_to_contact(cp->d);
+    if (t <= 0) return INFINITY; /* in contact: the fluid stays frozen over a whole step */
+    const double tmin = 0.25 * dem_contact_time(cp->d);
+    return t > tmin ? t : INFINITY; /* it starts early in the next step anyway */
+}
+
+static void part_advance(void *ctx, double dt)
+{
+    coupling_part_t *cp = ctx;
+    setup(cp);
+    cp->rest.lub_impulse = 0;
+    if (cp->ibm) {
+        const double w0 = wtime();
+        coupling_forces_to_dem(cp->ibm, cp->d, cp->rho_f, cp->gravity);
+        cp->status = dem_advance(cp->d, dem_time(cp->d) + dt);
+        cp->wall_dem += wtime() - w0;
+        if (cp->status == DEM_OK) coupling_motion_to_ibm(cp->d, cp->ibm);
+    }
+    restitution_sample(&cp->rest, cp->d, cp->sim->time + dt);
+}
+
+static void part_diagnostics(void *ctx, double *c)
+{
+    coupling_part_t *cp = ctx;
+    setup(cp);
+    c[0] = restitution_approach_speed(&cp->rest, cp->d, 0);
+    c[1] = cp->sim->dt > 0 ? cp->rest.lub_impulse / cp->sim->dt : 0.0;
+}
+
+static int part_diverged(void *ctx, char *why, size_t n)
+{
+    coupling_part_t *cp = ctx;
+    if (cp->status == DEM_OK) return 0;
+    snprintf(why, n, "dem (coupled): %s", dem_error(cp->d));
+    return 1;
+}
+
+/* The tracker's state (exact restarts of the measurements). */
+#define REST_NSTATE 10
+static void pack(const restitution_t *r, double *v)
+{
+    const double s[REST_NSTATE] = {r->phase, r->u_last, r->VT, r->VC, r->VR, r->VR_release, r->t_contact, r->t_release,
+                                   r->lub_impulse, r->VC_onset};
+    memcpy(v, s, sizeof s);
+}
+
+static void part_checkpoint_write(void *ctx, hid_t grp)
+{
+    coupling_part_t *cp = ctx;
+    double v[REST_NSTATE];
+    pack(&cp->rest, v);
+    io_h5_write_array(grp, "restitution", REST_NSTATE, v);
+}
+
+static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
+{
+    coupling_part_t *cp = ctx;
+    double v[REST_NSTATE];
+    if (io_h5_read_array(grp, "restitution", REST_NSTATE, v) != REST_NSTATE)
+        die("%s: /coupling/restitution is missing or has the wrong size", path);
+    restitution_t *r = &cp->rest;
+    r->phase = (int)v[0];
+    r->u_last = v[1], r->VT = v[2], r->VC = v[3], r->VR = v[4], r->VR_release = v[5];
+    r->t_contact = v[6], r->t_release = v[7], r->lub_impulse = v[8], r->VC_onset = v[9];
+    cp->synced = 1; /* the spheres and particles come from the checkpoint */
+    cp->d = sim_dem_engine(cp->sim);
+    tracked_particle(cp);
+    dem_get_gravity(cp->d, cp->gravity);
+    if (cp->rest.mode != RESTITUTION_OFF) dem_set_step_observer(cp->d, observe, cp);
+    if (cp->ibm) memcpy(cp->ibm->prm.gravity, cp->gravity, sizeof cp->gravity);
+}
+
+static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
+{
+    coupling_part_t *cp = ctx;
+    setup(cp);
+    char key[128];
+#define KEY(name) (snprintf(key, sizeof key, "%s.%s", prefix, name), key)
+    io_summary_string(y, KEY("fluid"), cp->ibm ? "resolved" : "off");
+    io_summary_long(y, KEY("dem_substeps"), cp->substeps);
+    io_summary_double(y, KEY("dem_wall_seconds"), cp->wall_dem);
+    const restitution_t *r = &cp->rest;
+    if (r->mode != RESTITUTION_OFF) {
+        const int wall = r->mode == RESTITUTION_WALL;
+        io_summary_string(y, KEY("restitution_mode"), wall ? "wall" : "pair");
+        io_summary_bool(y, KEY("contact"), r->phase > 0);
+        io_summary_bool(y, KEY("rebound"), r->VR > 0);
+        io_summary_double(y, KEY(wall ? "V_T" : "U_i"), r->VT);
+        io_summary_double(y, KEY(wall ? "V_C" : "U_c"), r->VC);
+        io_summary_double(y, KEY(wall ? "V_R" : "U_r"), r->VR);
+        io_summary_double(y, KEY(wall ? "V_C_onset" : "U_c_onset"), r->VC_onset);
+        io_summary_double(y, KEY("V_release"), r->VR_release);
+        io_summary_double(y, KEY("V_C_over_V_T"), r->VT > 0 ? r->VC / r->VT : 0.0);
+        io_summary_double(y, KEY(wall ? "epsilon" : "epsilon_B"), restitution_epsilon(r));
+        io_summary_double(y, KEY("epsilon_max"), r->e_dry);
+        io_summary_double(y, KEY("epsilon_over_max"), r->e_dry > 0 ? restitution_epsilon(r) / r->e_dry : 0.0);
+        io_summary_double(y, KEY(wall ? "St" : "St_B"), restitution_stokes(r));
+        io_summary_double(y, KEY(wall ? "Re_p" : "Re_rel"), restitution_reynolds(r));
+        io_summary_double(y, KEY("t_contact"), r->t_contact);
+        io_summary_double(y, KEY("t_release"), r->t_release);
+        io_summary_bool(y, KEY("second_contact"), r->phase == 3);
+    }
+#undef KEY
+}
+
+/* The bounce is measured: moving towards the wall again after the
+ * rebound, a second contact, resting in contact for 40 t_c, or at rest
+ * before touching (the lubrication stopped it: speed below 1e-3 V_T). */
+static int part_done(void *ctx)
+{
+    coupling_part_t *cp = ctx;
+    if (!cp->stop_after || !cp->synced) return 0;
+    const restitution_t *r = &cp->rest;
+    const double u = restitution_approach_speed(r, cp->d, 0), t = dem_time(cp->d);
+    switch (r->phase) {
+    case 0: return r->VT > 0 && fabs(u) < 1e-3 * r->VT && cp->sim->step > 10;
+    case 1: return t - r->t_contact > 40 * dem_contact_time(cp->d);
+    case 2: return u > 0 && r->VR > 0;
+    default: return 1;
+    }
+}
+
+static void part_destroy(void *ctx) { free(ctx); }
+
+void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
+{
+    coupling_part_t *cp = xcalloc(1, sizeof *cp);
+    cp->sim = s;
+    cp->cfg = cfg;
+    cp->ibm = ibm;
+    cp->rho_f = s->fluid ? s->fluid->prm.rho : (cfg_has_section(cfg, "fluid") ? cfg_double(cfg, "fluid", "rho") : 0.0);
+    const int mode = cfg_enum(cfg, "coupling", "restitution");
+    double g[3], axis[3];
+    cfg_vec3(cfg, "dem", "gravity", g);
+    if (cfg_has(cfg, "coupling", "restitution_axis"))
+        cfg_vec3(cfg, "coupling", "restitution_axis", axis);
+    else
+        memcpy(axis, g, sizeof axis);
+    if (mode == RESTITUTION_WALL && axis[0] == 0 && axis[1] == 0 && axis[2] == 0)
+        cfg_fail(cfg, "coupling", "restitution_axis", "needed: there is no gravity to take the direction from");
+    double mu = 0;
+    if (cfg_has_section(cfg, "fluid")) mu = cfg_double(cfg, "fluid", "rho") * cfg_double(cfg, "fluid", "nu");
+    if (cfg_enum(cfg, "lubrication", "model") == 1 && cfg_double(cfg, "lubrication", "viscosity") > 0)
+        mu = cfg_double(cfg, "lubrication", "viscosity");
+    /* density, diameter and ε_max of the tracked particle: at setup */
+    restitution_init(&cp->rest, (restitution_mode_t)mode, axis, cp->rho_f, mu, 0.0, 0.0, 0.0);
+    cp->align = cfg_bool(cfg, "coupling", "align_contacts");
+    cp->stop_after = mode != RESTITUTION_OFF && cfg_bool(cfg, "coupling", "stop_after_rebound");
+    sim_part_t part = {
+        .name = "coupling",
+        .ctx = cp,
+        .stable_dt = part_stable_dt,
+        .advance = part_advance,
+        .ncol = mode ? 2 : 0,
+        .col_names = rest_cols,
+        .diagnostics = part_diagnostics,
+        .diverged = part_diverged,
+        .checkpoint_write = part_checkpoint_write,
+        .checkpoint_read = part_checkpoint_read,
+        .summary = part_summary,
+        .done = part_done,
+        .destroy = part_destroy,
+    };
+    sim_add_part(s, &part);
+}

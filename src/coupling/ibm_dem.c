@@ -1,0 +1,64 @@
+/* ibm_dem.c — the exchanges of the resolved coupling (coupling.h): DEM
+ * particles as immersed spheres, hydrodynamic forces to the DEM, motion
+ * back to the immersed boundary.  Sphere p is the particle of id p. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "coupling.h"
+#include "util.h"
+
+ibm_sphere_t *coupling_spheres_of_particles(const dem_t *d, int *n)
+{
+    const int np = dem_count(d);
+    ibm_sphere_t *s = xcalloc((size_t)(np > 0 ? np : 1), sizeof *s);
+    const double *x = dem_positions(d), *v = dem_velocities(d), *w = dem_omegas(d), *r = dem_radii(d);
+    const long *id = dem_ids(d);
+    for (int i = 0; i < np; i++) {
+        if (id[i] < 0 || id[i] >= np) die("coupling: particle ids must be 0..N-1 (got %ld)", id[i]);
+        ibm_sphere_t *t = &s[id[i]];
+        t->kind = IBM_EXTERNAL;
+        t->radius = r[i];
+        t->density = dem_mass(d, i) / (4.0 / 3.0 * M_PI * r[i] * r[i] * r[i]);
+        t->history = -1;
+        for (int a = 0; a < 3; a++) {
+            t->x[a] = t->xa[a] = x[3 * i + a];
+            t->u[a] = v[3 * i + a];
+            t->omega[a] = w[3 * i + a];
+        }
+    }
+    *n = np;
+    return s;
+}
+
+void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3])
+{
+    double *fe = dem_ext_force(d), *te = dem_ext_torque(d);
+    const double *r = dem_radii(d);
+    const long *id = dem_ids(d);
+    for (int i = 0; i < dem_count(d); i++) {
+        const ibm_sphere_t *s = &ibm->s[id[i]];
+        const double V = 4.0 / 3.0 * M_PI * r[i] * r[i] * r[i];
+        for (int a = 0; a < 3; a++) {
+            /* decision 7: the fluid pressure is relative to hydrostatic, so the DEM's weight m_p g
+             * needs the buoyancy −ρ V_p g besides the hydrodynamic force of the immersed boundary */
+            fe[3 * i + a] = s->force[a] - rho_fluid * V * gravity[a];
+            te[3 * i + a] = s->torque[a];
+        }
+    }
+}
+
+void coupling_motion_to_ibm(const dem_t *d, ibm_t *ibm)
+{
+    const double *x = dem_positions(d), *v = dem_velocities(d), *w = dem_omegas(d);
+    const long *id = dem_ids(d);
+    for (int i = 0; i < dem_count(d); i++) {
+        ibm_sphere_t *s = &ibm->s[id[i]];
+        for (int a = 0; a < 3; a++) {
+            s->x[a] = x[3 * i + a];
+            s->u[a] = v[3 * i + a];
+            s->omega[a] = w[3 * i + a];
+        }
+    }
+    ibm_update_geometry(ibm);
+}

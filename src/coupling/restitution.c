@@ -1,0 +1,145 @@
+/* restitution.c — restitution of a bounce measured during the run
+ * (decision 8; Izard 2014 §3.1.3.1 and §3.2 of the reference notes).
+ *
+ * Wall: the particle of id 0 moves along `axis` (towards the wall).  Its
+ * approach speed u = v·axis is sampled at the end of every fluid step and
+ * at every DEM sub-step:
+ *   V_T  the largest approach speed before the first contact, over the fluid
+ *        steps ("the terminal velocity before any wall influence");
+ *   V_C  the approach speed at the last fluid step before the contact (the
+ *        seed's velocity histories are sampled at the fluid steps); the
+ *        speed at the last sub-step before the contact, V_C_onset, is lower
+ *        by the lubrication of the last fraction of the gap (up to a fluid
+ *        step's displacement), ∝ ln of that gap over η_e;
+ *   V_R  the largest rebound speed −u after the contact, over the fluid
+ *        steps until the next contact ("the maximum value of the velocity of
+ *        opposite sign just after detachment": the seed's velocity history
+ *        is the particle's at the fluid steps, after the lubrication of the
+ *        detachment has acted — see docs/theory.md §9);
+ *   ε = V_R/V_T, St = (ρ_p + ρ/2) V_T D/(9μ), Re_p = ρ V_T D/μ  (eq. 3.19).
+ * Pair: the relative approach speed (v₀ − v₁)·n₀₁ of the particles of ids 0
+ * and 1 (n₀₁ from 0 to 1), ε_B = −(U_r1 − U_r2)/(U_i1 − U_i2), St_B = ρ_p U D/(9μ),
+ * Re = ρ U D/μ  (eq. 3.34–3.35).
+ * A contact is on while the tracked particle carries a contact force (the
+ * normal force is clipped at zero: the contact ends when it vanishes).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "coupling.h"
+
+void restitution_init(restitution_t *r, restitution_mode_t mode, const double axis[3], double rho_f, double mu,
+                      double rho_p, double D, double e_dry)
+{
+    memset(r, 0, sizeof *r);
+    r->mode = mode;
+    const double n = sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]);
+    for (int a = 0; a < 3; a++) r->axis[a] = n > 0 ? axis[a] / n : 0.0;
+    r->rho_f = rho_f;
+    r->mu = mu;
+    r->rho_p = rho_p;
+    r->D = D;
+    r->e_dry = e_dry;
+    r->t_contact = r->t_release = -1;
+}
+
+/* index of the particle with this id (−1 if absent) */
+static int index_of(const dem_t *d, long id)
+{
+    const long *ids = dem_ids(d);
+    for (int i = 0; i < dem_count(d); i++)
+        if (ids[i] == id) return i;
+    return -1;
+}
+
+double restitution_approach_speed(const restitution_t *r, dem_t *d, int full_step)
+{
+    const int i = index_of(d, 0);
+    if (i < 0) return 0.0;
+    double vi[3];
+    if (full_step)
+        dem_full_velocity(d, i, vi);
+    else
+        memcpy(vi, dem_velocities(d) + 3 * i, sizeof vi);
+    if (r->mode == RESTITUTION_WALL) return vi[0] * r->axis[0] + vi[1] * r->axis[1] + vi[2] * r->axis[2];
+    const int j = index_of(d, 1);
+    if (j < 0) return 0.0;
+    double vj[3], n[3], len = 0;
+    if (full_step)
+        dem_full_velocity(d, j, vj);
+    else
+        memcpy(vj, dem_velocities(d) + 3 * j, sizeof vj);
+    const double *x = dem_positions(d);
+    for (int a = 0; a < 3; a++) {
+        n[a] = x[3 * j + a] - x[3 * i + a];
+        len += n[a] * n[a];
+    }
+    len = sqrt(len);
+    double u = 0;
+    for (int a = 0; a < 3; a++) u += (vi[a] - vj[a]) * n[a] / len;
+    return u;
+}
+
+static int in_contact(const restitution_t *r, dem_t *d)
+{
+    (void)r;
+    const int i = index_of(d, 0);
+    if (i < 0) return 0;
+    const double *f = dem_contact_forces(d) + 3 * i;
+    return f[0] != 0 || f[1] != 0 || f[2] != 0;
+}
+
+void restitution_substep(restitution_t *r, dem_t *d)
+{
+    if (r->mode == RESTITUTION_OFF) return;
+    const double u = restitution_approach_speed(r, d, 1);
+    const int c = in_contact(r, d);
+    const int i = index_of(d, 0);
+    if (i >= 0) {
+        const double *fl = dem_lubrication_forces(d) + 3 * i;
+        /* impulse along the approach direction: positive when it pushes the particle back */
+        r->lub_impulse -= dem_dt(d) * (fl[0] * r->axis[0] + fl[1] * r->axis[1] + fl[2] * r->axis[2]);
+    }
+    switch (r->phase) {
+    case 0:
+        if (c) {
+            r->phase = 1;
+            r->VC_onset = r->u_last;
+            r->t_contact = dem_time(d);
+        }
+        break;
+    case 1:
+        if (!c) {
+            r->phase = 2;
+            r->VR_release = -u;
+            r->t_release = dem_time(d);
+        }
+        break;
+    case 2:
+        if (c) r->phase = 3;
+        break;
+    default: break;
+    }
+    r->u_last = u;
+}
+
+void restitution_sample(restitution_t *r, dem_t *d, double time)
+{
+    (void)time;
+    if (r->mode == RESTITUTION_OFF) return;
+    const double u = restitution_approach_speed(r, d, 0);
+    if (r->phase == 0 && u > r->VT) r->VT = u;
+    if (r->phase == 0) r->VC = u;
+    if (r->phase == 2 && -u > r->VR) r->VR = -u;
+}
+
+double restitution_epsilon(const restitution_t *r) { return r->VT > 0 ? r->VR / r->VT : 0.0; }
+
+double restitution_stokes(const restitution_t *r)
+{
+    if (!(r->mu > 0)) return INFINITY;
+    const double rho_eff = r->rho_p + (r->mode == RESTITUTION_WALL ? 0.5 * r->rho_f : 0.0);
+    return rho_eff * r->VT * r->D / (9 * r->mu);
+}
+
+double restitution_reynolds(const restitution_t *r) { return r->mu > 0 ? r->rho_f * r->VT * r->D / r->mu : INFINITY; }

@@ -1,0 +1,245 @@
+/* test_dem_lubrication.c — Brenner lubrication with effective roughness
+ * (Izard eq. 3.18, decision 5; src/dem/lubrication.c).
+ * RANKS: 1 2
+ *
+ * Exact results used:
+ *  - Lubrication alone (no gravity, no contact yet): m* du/dt = −k u/(δ+η_e)
+ *    with u = −dδ/dt has the first integral u − (k/m*) L(δ) = const,
+ *    L(δ) = ln(δ + η_e) (minus δ/(Δ_lub + η_e) with subtract_resolved),
+ *    clamped to the active range (0, Δ_lub].  The scheme keeps it exactly
+ *    (lubrication.c), so it is checked at every step to round-off, for a
+ *    sphere against a wall and for a pair (reduced mass, R_eff = R/2), with
+ *    momentum conserved to round-off for the pair.
+ *  - With St = m* u₀/k below ΔL = ln((Δ_lub + η_e)/η_e) the sphere stops at
+ *    the gap where L(δ*) = L(δ₀) − St; above, it reaches contact at
+ *    u_C = u₀ − (k/m*) ΔL, leaves it at ε_max u_C (the calibrated contact law)
+ *    and is slowed again by ΔL: u_R = ε_max u_C − (k/m*) ΔL.
+ *  - Stiff case (η_e/R = 1e-6, St ≈ 1, constant push): the ODE
+ *    m du/dt = F − k u/(δ + η_e) integrated by a fine adaptive reference;
+ *    the DEM step t_c/50 is ≫ the explicit stability limit 2m(δ+η_e)/k near
+ *    contact, and the solution must stay stable and converge.
+ */
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/dem/dem_private.h"
+#include "dem.h"
+#include "modules.h"
+#include "testutil.h"
+
+static const double R = 1e-3, RHO = 2500, TC = 1e-4, MU = 1e-2;
+
+/* A DEM with walls on z_lo (wall != 0) or none, lubrication roughness eta,
+ * range, subtract. */
+static dem_t *make(int wall, double eta, double range, int subtract, int nc, double gz, double e_dry)
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "[domain]\nlength = 0.1 0.1 0.1\n[boundary]\nz_lo = noslip\nz_hi = noslip\n"
+             "[walls]\nfaces = %s\n[contact]\nrestitution = %.17g\ncontact_time = %g\nfriction = 0.3\n"
+             "[lubrication]\nmodel = brenner\nroughness = %.17g\nrange = %.17g\nsubtract_resolved = %s\nviscosity = %g\n"
+             "[dem]\ngravity = 0 0 %.17g\nsteps_per_contact = %d\n",
+             wall ? "z_lo" : "none", e_dry, TC, eta / R, range / R, subtract ? "true" : "false", MU, gz, nc);
+    cfg_t *cfg = cfg_load_string("test.ini", text, 0, NULL);
+    assert_non_null(cfg);
+    return dem_create_from_config(cfg, MPI_COMM_WORLD);
+}
+
+static double Lpot(double delta, double eta, double range, int subtract)
+{
+    const double c = delta < 0 ? 0 : delta > range ? range : delta;
+    return log(c + eta) - (subtract ? c / (range + eta) : 0.0);
+}
+
+/* Lone sphere against the wall: the first integral at every step, and the
+ * stopping gap (St < ΔL) or the rebound velocity (St > ΔL). */
+static void wall_invariant(double St, int subtract, double *worst, double *stop_or_rebound, double *vmax_after)
+{
+    const double eta = 1e-4 * R, range = 0.5 * R;
+    dem_t *d = make(1, eta, range, subtract, 50, 0.0, 0.9);
+    const double m = RHO * 4.0 / 3.0 * M_PI * R * R * R, k = 6 * M_PI * MU * R * R;
+    const double u0 = St * k / m, gap0 = 0.6 * R;
+    const double x[3] = {0.05, 0.05, R + gap0}, v[3] = {0, 0, -u0};
+    dem_add_particle(d, x, v, R, RHO, 0);
+    const double C = u0 - k / m * Lpot(gap0, eta, range, subtract);
+    *worst = 0;
+    double vmax_up = 0, min_gap = 1;
+    int touched = 0;
+    for (long s = 0; s < 400000; s++) {
+        assert_int_equal(dem_step(d), DEM_OK);
+        const double gap = dem_positions(d)[2] - R, u = -dem_velocities(d)[2];
+        if (gap < min_gap) min_gap = gap;
+        if (gap <= 0) touched = 1;
+        if (!touched) {
+            const double err = fabs(u - k / m * Lpot(gap, eta, range, subtract) - C) / u0;
+            if (err > *worst) *worst = err;
+        }
+        if (-u > vmax_up) vmax_up = -u;
+        if (gap > 0.7 * R && touched) break;
+        if (!touched && fabs(u) < 1e-12 * u0) break; /* stopped */
+    }
+    *stop_or_rebound = touched ? dem_velocities(d)[2] : min_gap;
+    *vmax_after = vmax_up;
+    dem_free(d);
+}
+
+static void test_wall_first_integral(void **state)
+{
+    (void)state;
+    const double eta = 1e-4 * R, range = 0.5 * R;
+    const double dL = log((range + eta) / eta); /* 8.52 */
+    for (int sub = 0; sub < 2; sub++) {
+        const double dLs = dL - (sub ? range / (range + eta) : 0.0);
+        /* St = 5 < ΔL: stops at L(δ*) = L(Δ_lub) − St */
+        double worst, stop, vmax;
+        wall_invariant(5.0, sub, &worst, &stop, &vmax);
+        const double expect = exp(Lpot(range, eta, range, 0) - 5.0) - eta; /* no-subtract form */
+        printf("wall St=5 subtract=%d: invariant error %.2e, stop gap %.6e R", sub, worst, stop / R);
+        if (!sub) printf(" (exact %.6e R)", expect / R);
+        printf("\n");
+        /* the invariant holds to round-off: ~1e-16 per step over ~1e4 steps of a quantity of
+         * size u0 (ln terms ~ 10 u0) */
+        assert_true(worst < 1e-10);
+        if (!sub) assert_true(fabs(stop - expect) < 1e-6 * R + 1e-3 * expect);
+        assert_true(stop > 0);
+        /* St = 40 > ΔL: contact at u_C, rebound at ε u_C (largest upward velocity), then slowed by
+         * ΔL again while it leaves the lubrication range */
+        double rebound;
+        wall_invariant(40.0, sub, &worst, &rebound, &vmax);
+        const double m = RHO * 4.0 / 3.0 * M_PI * R * R * R, k = 6 * M_PI * MU * R * R;
+        const double u0 = 40.0 * k / m, uC = u0 - k / m * dLs;
+        const double uR = 0.9 * uC - k / m * dLs;
+        printf("wall St=40 subtract=%d: invariant error %.2e, after contact %.6f u0 (exact %.6f), leaving the range "
+               "%.6f u0 (exact %.6f u0)\n",
+               sub, worst, vmax / u0, 0.9 * uC / u0, rebound / u0, uR / u0);
+        assert_true(worst < 1e-10);
+        /* the dry contact law's restitution error at t_c/dt = 50 is < 0.25 % of e (test_dem_collisions),
+         * and the lubrication after the contact adds no error of its own */
+        assert_true(fabs(vmax - 0.9 * uC) < 0.0025 * 0.9 * uC);
+        assert_true(fabs(rebound - uR) < 0.0025 * 0.9 * uC);
+    }
+}
+
+/* A pair of equal spheres head-on: relative first integral with m* = m/2,
+ * k = 6πη(R/2)², and momentum. */
+static void test_pair_first_integral(void **state)
+{
+    (void)state;
+    const double eta = 2e-4 * R, range = 0.5 * R;
+    dem_t *d = make(0, eta, range, 0, 50, 0.0, 0.9);
+    const double m = RHO * 4.0 / 3.0 * M_PI * R * R * R, ms = 0.5 * m, k = 6 * M_PI * MU * 0.25 * R * R;
+    const double St = 6.0, u0 = St * k / ms, gap0 = 0.55 * R;
+    const double xa[3] = {0.05, 0.05, 0.05 - R - gap0 / 2}, xb[3] = {0.05, 0.05, 0.05 + R + gap0 / 2};
+    const double va[3] = {0, 0, 0.75 * u0}, vb[3] = {0, 0, -0.25 * u0};
+    dem_add_particle(d, xa, va, R, RHO, 0);
+    dem_add_particle(d, xb, vb, R, RHO, 0);
+    const double C = u0 - k / ms * Lpot(gap0, eta, range, 0), P0 = m * 0.5 * u0;
+    double worst = 0, worst_p = 0;
+    for (long s = 0; s < 20000; s++) {
+        assert_int_equal(dem_step(d), DEM_OK);
+        const double *x = dem_positions(d), *v = dem_velocities(d);
+        const long *id = dem_ids(d);
+        const int a = id[0] == 0 ? 0 : 1, b = 1 - a;
+        const double gap = x[3 * b + 2] - x[3 * a + 2] - 2 * R, u = v[3 * a + 2] - v[3 * b + 2];
+        assert_true(gap > 0);
+        worst = fmax(worst, fabs(u - k / ms * Lpot(gap, eta, range, 0) - C) / u0);
+        worst_p = fmax(worst_p, fabs(m * (v[2] + v[5]) - P0) / P0);
+    }
+    const double *x = dem_positions(d);
+    const double gap_end = fabs(x[5] - x[2]) - 2 * R, expect = exp(Lpot(gap0, eta, range, 0) - St) - eta;
+    printf("pair St=6: invariant error %.2e, momentum error %.2e, final gap %.6e R (exact %.6e R)\n", worst,
+           worst_p, gap_end / R, expect / R);
+    /* Newton tolerance 1e-15 of the bracket (~1.4 u0) per step, 2e4 steps, plus rounding */
+    assert_true(worst < 1e-9);
+    assert_true(worst_p < 1e-13);
+    assert_true(fabs(gap_end - expect) < 1e-6 * expect);
+    dem_free(d);
+}
+
+/* Reference for the stiff case: m u' = F − k u/(δ+η), δ' = −u, by RK4 in
+ * the variable s = ln(δ + η) with many small steps (smooth in s). */
+static double stiff_reference_gap(double F, double m, double k, double eta, double gap0, double u0, double T)
+{
+    /* integrate in time with an adaptive step limited by the local rate k/(m(δ+η)) */
+    double t = 0, g = gap0, u = u0;
+    while (t < T) {
+        const double rate = k / (m * (g + eta)) + fabs(u) / (g + eta);
+        double h = 0.01 / rate;
+        if (t + h > T) h = T - t;
+#define RHS(G, U, dg, du) ((dg) = -(U), (du) = (F - k * (U) / ((G) + eta)) / m)
+        double g1, u1, g2, u2, g3, u3, g4, u4;
+        RHS(g, u, g1, u1);
+        RHS(g + 0.5 * h * g1, u + 0.5 * h * u1, g2, u2);
+        RHS(g + 0.5 * h * g2, u + 0.5 * h * u2, g3, u3);
+        RHS(g + h * g3, u + h * u3, g4, u4);
+#undef RHS
+        g += h / 6 * (g1 + 2 * g2 + 2 * g3 + g4);
+        u += h / 6 * (u1 + 2 * u2 + 2 * u3 + u4);
+        t += h;
+    }
+    return g;
+}
+
+static double stiff_run(int nc, double T, double *gap_T, double *stiffness, int *bounced)
+{
+    const double eta = 1e-6 * R, range = 0.5 * R, gz = -9.81;
+    dem_t *d = make(1, eta, range, 0, nc, gz, 0.97);
+    const double m = RHO * 4.0 / 3.0 * M_PI * R * R * R, k = 6 * M_PI * MU * R * R;
+    const double u0 = 1.0 * k / m; /* St = 1 */
+    const double gap0 = 0.4 * R;
+    const double x[3] = {0.05, 0.05, R + gap0}, v[3] = {0, 0, -u0};
+    dem_add_particle(d, x, v, R, RHO, 0);
+    const double dt = TC / nc;
+    const long n = lround(T / dt);
+    *stiffness = 0;
+    *bounced = 0;
+    for (long s = 0; s < n; s++) {
+        assert_int_equal(dem_step(d), DEM_OK);
+        const double gap = dem_positions(d)[2] - R, vz = dem_velocities(d)[2];
+        assert_true(isfinite(gap) && gap > -0.01 * R);
+        *stiffness = fmax(*stiffness, k * dt / (m * (fmax(gap, 0) + eta)));
+        if (vz > 1e-3 * u0) *bounced = 1;
+    }
+    *gap_T = dem_positions(d)[2] - R;
+    dem_free(d);
+    return stiff_reference_gap(m * fabs(gz), m, k, eta, gap0, u0, n * dt);
+}
+
+static void test_stiff_small_roughness(void **state)
+{
+    (void)state;
+    /* T: the gap falls from 0.4 R to ~1e-5 R, where k dt/(m(δ+η)) > 2: an explicit
+     * treatment of the lubrication would be unstable there (Mongruel's linear regime:
+     * δ + η decays as exp(−t m g/k), k/(m g) = 1.8 ms) */
+    const double T = 0.019;
+    double e[3], ref[3];
+    const int ncs[3] = {50, 100, 200};
+    for (int q = 0; q < 3; q++) {
+        double gapT, stiff;
+        int bounced;
+        ref[q] = stiff_run(ncs[q], T, &gapT, &stiff, &bounced);
+        e[q] = fabs(gapT - ref[q]) / ref[q];
+        printf("stiff eta/R=1e-6 St=1 t_c/dt=%d: gap(T) %.6e R, reference %.6e R, rel. error %.2e, max k dt/(m(δ+η)) %.3g, "
+               "bounced %d\n",
+               ncs[q], gapT / R, ref[q] / R, e[q], stiff, bounced);
+        assert_false(bounced); /* St = 1 ≪ St_c: no rebound */
+        if (q == 0) assert_true(stiff > 2.0); /* beyond the explicit stability limit: the test is stiff */
+    }
+    const double p1 = conv_order(e[0], e[1], 2), p2 = conv_order(e[1], e[2], 2);
+    printf("stiff case: orders %.2f %.2f\n", p1, p2);
+    /* first order at least (the lubrication impulse is implicit in the gap, the push explicit) */
+    assert_true(p1 > 0.8 && p2 > 0.8);
+    assert_true(e[0] < 0.05);
+}
+
+int main(int argc, char **argv)
+{
+    test_mpi_init(&argc, &argv);
+    modules_register_keys();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_wall_first_integral),
+        cmocka_unit_test(test_pair_first_integral),
+        cmocka_unit_test(test_stiff_small_roughness),
+    };
+    TEST_MPI_RUN("dem_lubrication", tests);
+}
