@@ -71,6 +71,11 @@ typedef struct {
     /* State carried between stages (checkpointed): the velocity and
      * angular-velocity increments of the last stage (virtual-mass term). */
     double du_prev[3], dw_prev[3];
+    /* Fixed and external spheres: where the velocity of the last fluid step
+     * would have taken the centre (xa + Δt u; checkpointed): the part of
+     * their next move that it predicts is counted in the force, the rest
+     * is not (docs/theory.md §6b). */
+    double xpred[3];
 } ibm_sphere_t;
 
 typedef struct {

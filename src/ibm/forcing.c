@@ -264,29 +264,55 @@ static int step_frozen(const ibm_t *ibm)
     return 1;
 }
 
-/* Fixed and external spheres set to new centres x from outside: each keeps
- * the momentum I, L of the fluid of its last solid fraction (centre xa),
- * with L taken about the new centre (L − δ × I for the displacement δ), so
- * that the next impulse ρ(I^k − I^{k−1}) contains the change of the
- * momentum inside the sphere due to its jump and the impulses telescope
- * over the steps as they do over the stages (docs/theory.md §6b); then
- * xa = x.  Returns whether any of them moved (the node lists are to be
- * rebuilt). */
+/* Fixed and external spheres set to new centres x from outside (the
+ * coupling, between steps): α at the new centres, and the momentum I^0, L^0
+ * from which the next step's impulse is counted.  Over a move δ = x − xa,
+ * the fluid momentum inside the sphere changes from I_old (old α, carried
+ * from the end of the last step) to I_new (new α).  The part of the move
+ * that the last step's velocity predicts, δ_p = xpred − xa, is the motion
+ * of the sphere during that step, which a sphere moved within the step
+ * (prescribed) counts in its force; the rest (e.g. a collision resolved by
+ * the DEM within the step) is not counted, as when α is rebuilt at the new
+ * centre.  Along the move, I^0 = I_old + (1 − λ)(I_new − I_old) with
+ * λ = δ_p·δ/|δ|² (λ = 1: the whole change is counted, the impulses
+ * telescope over the steps; λ = 0: I^0 = I_new), L likewise about the new
+ * centre (L_old − δ × I_old).  Returns whether any sphere moved (then the
+ * node lists are rebuilt here). */
 static int carry_external_moves(ibm_t *ibm)
 {
     ibm_priv_t *q = ibm_priv(ibm);
     int moved = 0;
+    double *lam = xcalloc((size_t)ibm->n, sizeof(double)), *old = xcalloc(6 * (size_t)ibm->n, sizeof(double));
+    char *mv = xcalloc((size_t)ibm->n, 1);
     for (int p = 0; p < ibm->n; p++) {
         ibm_sphere_t *s = &ibm->s[p];
         if ((s->kind != IBM_FIXED && s->kind != IBM_EXTERNAL) || !memcmp(s->xa, s->x, sizeof s->x)) continue;
-        double dx[3], *I = q->mom_prev + 6 * p, *L = I + 3;
+        double dx[3], dp[3], *I = q->mom_prev + 6 * p, *L = I + 3, dd = 0, dpd = 0;
         displacement(ibm->g, s->xa, s->x, dx);
+        displacement(ibm->g, s->xa, s->xpred, dp);
+        for (int d = 0; d < 3; d++) dd += dx[d] * dx[d], dpd += dp[d] * dx[d];
+        lam[p] = dd > 0 ? dpd / dd : 0.0;
         L[0] -= dx[1] * I[2] - dx[2] * I[1];
         L[1] -= dx[2] * I[0] - dx[0] * I[2];
         L[2] -= dx[0] * I[1] - dx[1] * I[0];
+        memcpy(old + 6 * p, I, 6 * sizeof(double));
         memcpy(s->xa, s->x, sizeof s->x);
-        moved = 1;
+        moved = mv[p] = 1;
     }
+    if (moved) {
+        ibm_build_nodes(ibm);
+        ibm_momentum(ibm, q->sum);
+        reduce_sums(ibm);
+        for (int p = 0; p < ibm->n; p++)
+            if (mv[p])
+                for (int d = 0; d < 6; d++) {
+                    double now = q->sum[(long)p * IBM_NSUM + IBM_MOM + d];
+                    q->mom_prev[6 * p + d] = old[6 * p + d] + (1.0 - lam[p]) * (now - old[6 * p + d]);
+                }
+    }
+    free(lam);
+    free(old);
+    free(mv);
     return moved;
 }
 
@@ -328,7 +354,7 @@ void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
         q->frozen = step_frozen(ibm);
         /* the moves made since the last step (ibm_update_geometry) */
         double w0 = wtime();
-        if (q->frozen && carry_external_moves(ibm)) ibm_build_nodes(ibm);
+        if (q->frozen) carry_external_moves(ibm);
         ibm->wall_alpha += wtime() - w0;
     }
     double w0 = wtime();
@@ -483,6 +509,7 @@ void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx)
             for (int d = 0; d < 3; d++) {
                 ibm->s[p].force[d] = J[d] / q->t_step;
                 ibm->s[p].torque[d] = K[d] / q->t_step;
+                ibm->s[p].xpred[d] = ibm->s[p].xa[d] + q->t_step * ibm->s[p].u[d];
             }
             for (int d = 0; d < 6; d++) q->mom_prev[6 * p + d] = q->sum[(long)p * IBM_NSUM + IBM_MOM + d];
         }
@@ -518,6 +545,7 @@ void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx)
             for (int d = 0; d < 3; d++) {
                 ibm->s[p].force[d] = q->imp_step[6 * p + d] / q->t_step;
                 ibm->s[p].torque[d] = q->imp_step[6 * p + 3 + d] / q->t_step;
+                ibm->s[p].xpred[d] = ibm->s[p].xa[d] + q->t_step * ibm->s[p].u[d];
             }
     ibm->wall_alpha += w1 - w0;
     ibm->wall_integrals += wtime() - w1;

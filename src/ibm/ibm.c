@@ -189,6 +189,7 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
                 p + 1);
         if (ibm->s[p].kind != IBM_PRESCRIBED) ibm->s[p].history = -1;
         if (g->dim == 2) ibm->s[p].x[2] = 0.0;
+        memcpy(ibm->s[p].xpred, ibm->s[p].x, sizeof ibm->s[p].x);
     }
     for (int c = 0; c < g->dim; c++) {
         q->vol[c] = (double *)xcalloc((size_t)g->nxl + 2, sizeof(double)) + 1;
