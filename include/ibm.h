@@ -133,12 +133,13 @@ int ibm_add_history(ibm_t *ibm, int n, const double *rows);
 void ibm_prescribed_velocity(const ibm_t *ibm, const ibm_sphere_t *s, double t, double u[3], double w[3]);
 
 /* After changing spheres from outside (coupling): the solid fraction at
- * the current positions (xa = x; nothing is rebuilt if no sphere moved).
- * Free and prescribed spheres take the momentum inside them from the
- * current fluid velocity; fixed and external ones keep that of their last
- * solid fraction (angular momentum taken about the new centre), so that
- * the next step's force contains the momentum change of their jump.
- * Collective. */
+ * the current positions (xa = x).  When every sphere is fixed or external,
+ * the move is applied at the start of the next fluid step (nothing is
+ * rebuilt if no sphere moved), and each moved sphere carries the momentum
+ * inside it over its jump as docs/theory.md §6b says (the part of the jump
+ * that its last velocity predicts is counted in the next force).
+ * Otherwise at once; free and prescribed spheres then take the momentum
+ * inside them from the current fluid velocity.  Collective. */
 void ibm_update_geometry(ibm_t *ibm);
 /* The same from the stored xa (restart, rollback: the state as it was). */
 void ibm_rebuild_geometry(ibm_t *ibm);
