@@ -43,6 +43,8 @@ $(BUILD)/obj/%.o: src/%.c
 # handling the contact loop of src/dem/dem_kernel.inc vectorises (SIMD).  The
 # DEM uses OpenMP threads ([dem] threads; one thread by default).
 $(BUILD)/obj/dem/%.o: CFLAGS += -fno-math-errno -fopenmp
+# The same for the solid fraction of the immersed boundary (src/ibm/alpha.c).
+$(BUILD)/obj/ibm/%.o: CFLAGS += -fno-math-errno
 
 $(LIB): $(OBJ)
 	@rm -f $@

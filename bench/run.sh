@@ -46,7 +46,7 @@ if want porenet && [ -x "$BUILD/bench/bench_porenet" ]; then
     run porenet $MPIRUN -np 1 "$BUILD/bench/bench_porenet" 5000 20000
 fi
 if want ibm && [ -x "$BUILD/bench/bench_ibm" ]; then
-    run ibm $MPIRUN -np 1 "$BUILD/bench/bench_ibm"
+    for np in 1 2; do run ibm_np$np $MPIRUN -np $np "$BUILD/bench/bench_ibm"; done
 fi
 if want dem; then
     # ibmdem against LIGGGHTS on ../shared/bench/dem (installs liggghts; long)

@@ -11,7 +11,8 @@
  * fixed, prescribed (a constant velocity or a velocity history) and external
  * (moved by another module: the coupling with the DEM sets x, u, ω between
  * fluid steps, calls ibm_update_geometry(), and reads the hydrodynamic force
- * and torque of the step after fluid_step()).
+ * and torque of the step after fluid_step(); within the step an external
+ * sphere's solid fraction stays where it was put, forced with U + ω × r).
  *
  * It works through the fluid's two stage hooks (fluid.h): at every RK3
  * stage, before the projection, the predicted velocity is forced towards the
@@ -30,7 +31,12 @@
  *
  * Cost: each sphere touches only the nodes of its bounding box (radius plus
  * the band where 0 < α < 1): O(N_p (D/Δx)³) per stage, independent of the
- * grid size apart from one dense scratch field per velocity component.
+ * grid size.  The node lists of all spheres are kept in storage order and
+ * merged so that a node in several spheres' bands is forced once.  When
+ * every sphere is fixed or external (nothing moves within the step), α is
+ * built only when a sphere moved (ibm_update_geometry), the targets of the
+ * forcing once per step, and the impulse of each sphere once per step
+ * (docs/theory.md §6b).
  */
 #ifndef IBMDEM_IBM_H
 #define IBMDEM_IBM_H
@@ -65,6 +71,11 @@ typedef struct {
     /* State carried between stages (checkpointed): the velocity and
      * angular-velocity increments of the last stage (virtual-mass term). */
     double du_prev[3], dw_prev[3];
+    /* Fixed and external spheres: where the velocity of the last fluid step
+     * would have taken the centre (xa + Δt u; checkpointed): the part of
+     * their next move that it predicts is counted in the force, the rest
+     * is not (docs/theory.md §6b). */
+    double xpred[3];
 } ibm_sphere_t;
 
 typedef struct {
@@ -89,7 +100,7 @@ struct ibm {
      * integrals, particle update) since creation */
     double wall_alpha, wall_forcing, wall_integrals;
     long nodes_forced;     /* node entries (sphere, node) of the last stage, this rank */
-    long nodes_shared;     /* ... of them in runs that another sphere's band may reach */
+    long nodes_shared;     /* ... of them at nodes that another sphere's band reaches too */
     void *priv;
 };
 
@@ -121,9 +132,14 @@ int ibm_add_history(ibm_t *ibm, int n, const double *rows);
 /* Velocity and angular velocity of a prescribed sphere at time t. */
 void ibm_prescribed_velocity(const ibm_t *ibm, const ibm_sphere_t *s, double t, double u[3], double w[3]);
 
-/* Rebuild the solid fraction and the momentum inside each sphere from the
- * current positions (xa = x) and fluid velocity: after changing spheres
- * from outside (coupling).  Collective. */
+/* After changing spheres from outside (coupling): the solid fraction at
+ * the current positions (xa = x).  When every sphere is fixed or external,
+ * the move is applied at the start of the next fluid step (nothing is
+ * rebuilt if no sphere moved), and each moved sphere carries the momentum
+ * inside it over its jump as docs/theory.md §6b says (the part of the jump
+ * that its last velocity predicts is counted in the next force).
+ * Otherwise at once; free and prescribed spheres then take the momentum
+ * inside them from the current fluid velocity.  Collective. */
 void ibm_update_geometry(ibm_t *ibm);
 /* The same from the stored xa (restart, rollback: the state as it was). */
 void ibm_rebuild_geometry(ibm_t *ibm);

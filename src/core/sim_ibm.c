@@ -210,7 +210,8 @@ static void write_sphere_arrays(const ibm_t *ibm, hid_t loc, int full)
              {"density", offsetof(ibm_sphere_t, density), 1, 0},
              {"alpha_centre", offsetof(ibm_sphere_t, xa), 3, 1},
              {"du_prev", offsetof(ibm_sphere_t, du_prev), 3, 1},
-             {"dw_prev", offsetof(ibm_sphere_t, dw_prev), 3, 1}};
+             {"dw_prev", offsetof(ibm_sphere_t, dw_prev), 3, 1},
+             {"predicted_centre", offsetof(ibm_sphere_t, xpred), 3, 1}};
     for (size_t i = 0; i < sizeof a / sizeof a[0]; i++) {
         if (a[i].state && !full) continue;
         gather(ibm, a[i].off, a[i].ncomp, buf);
@@ -298,6 +299,12 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
         if (io_h5_read_array(grp, a[i].name, 3 * n, buf) != a[i].ncomp * n) die("%s: /ibm/%s is missing", path, a[i].name);
         for (int p = 0; p < n; p++) memcpy((char *)&ibm->s[p] + a[i].off, buf + 3 * p, 3 * sizeof(double));
     }
+    /* the centre predicted by the last step (external spheres' moves, ibm.h);
+     * checkpoints written before it existed: the centre itself */
+    if (io_h5_read_array(grp, "predicted_centre", 3 * n, buf) == 3 * n)
+        for (int p = 0; p < n; p++) memcpy(ibm->s[p].xpred, buf + 3 * p, 3 * sizeof(double));
+    else
+        for (int p = 0; p < n; p++) memcpy(ibm->s[p].xpred, ibm->s[p].x, 3 * sizeof(double));
     free(buf);
     if (io_h5_get_attr_long(grp, "snapshots", &ns) == 0 && ns > 0) {
         ip->snap_cap = (int)ns + 64;

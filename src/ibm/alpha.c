@@ -221,31 +221,10 @@ typedef struct {
     const ibm_t *ibm;
     ibm_priv_t *q;
     int p;
-    double R, band, retraction;
 } build_ctx_t;
 
-/* Does the segment of nodes (first at offset r0 from sphere p, len nodes
- * along the run direction) come within R_out of a neighbour of p?  The
- * distance is that of the continuous segment, so the answer is never "no"
- * for a node that a neighbour's runs contain: a node in two spheres' runs
- * is in a shared run of both. */
-static int segment_shared(const ibm_t *ibm, int p, const double r0[3], int len, double h)
-{
-    const ibm_priv_t *q = ibm_priv(ibm);
-    int rd = q->rdir;
-    for (int e = q->nb_start[p]; e < q->nb_start[p + 1]; e++) {
-        const struct ibm_neighbour *nb = &q->nb[e];
-        double Rout = ibm->s[nb->o].radius + (ibm_band_halfwidth() - ibm->prm.retraction) * h + 1e-9 * h;
-        double v[3] = {r0[0] - nb->d[0], r0[1] - nb->d[1], r0[2] - nb->d[2]}; /* the first node seen from o */
-        /* closest point of [v, v + (len − 1) step e_rd] to o's centre */
-        double t = -v[rd], tmax = (len - 1) * q->rstep;
-        t = t < 0 ? 0 : (t > tmax ? tmax : t);
-        v[rd] += t;
-        if (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] < Rout * Rout) return 1;
-    }
-    return 0;
-}
-
+/* α of the node at offset r from the centre of a sphere of radius R: the
+ * profile of ibm_alpha() (the cell-centre fraction of the snapshots). */
 static inline double alpha_at(double R, double band, double retraction, const double r[3], double h)
 {
     double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
@@ -254,100 +233,191 @@ static inline double alpha_at(double R, double band, double retraction, const do
     double rr = sqrt(r2), d = rr - R + retraction * h;
     if (d >= band * h) return 0.0;
     if (d <= -band * h) return 1.0;
-    double n[3] = {r[0] / rr, r[1] / rr, r[2] / rr};
-    return ibm_alpha(d, n, h);
+    double lam = fabs(r[0] / rr) + fabs(r[1] / rr) + fabs(r[2] / rr);
+    double sigma = 0.065 * (1.0 - lam * lam) + 0.39;
+    return alpha_of_t(d / (sigma * lam * M_SQRT2 * h));
 }
 
+/* α of the len nodes of a run (first at offset r0, spacing step along rd)
+ * of a sphere of radius R_eff = R − retraction h: the profile of
+ * alpha_at() in two loops, the first (square root, divisions) without
+ * branches so that the compiler vectorises it, the second the table
+ * look-up.  Node k is at r0 + k step and λ takes one division, so the α
+ * differ from alpha_at() by round-off; the table is 0 beyond its end, and
+ * a node at the centre, where λ is 0/0, takes its end too (α = 1). */
+static void alpha_run(double Reff, const double r0[3], int rd, double step, double h, int len,
+                      double *restrict al)
+{
+    enum { CHUNK = 64 };
+    double x[CHUNK], p2 = 0.0, pa = 0.0, tscale = alpha_scale / (M_SQRT2 * h);
+    for (int d = 0; d < 3; d++)
+        if (d != rd) p2 += r0[d] * r0[d], pa += fabs(r0[d]);
+    for (int k0 = 0; k0 < len; k0 += CHUNK) {
+        int n = len - k0 < CHUNK ? len - k0 : CHUNK;
+        double z0 = r0[rd] + k0 * step;
+        for (int k = 0; k < n; k++) {
+            double z = z0 + k * step, rr = sqrt(p2 + z * z), d = rr - Reff;
+            double lam = (pa + fabs(z)) / rr, sigma = 0.065 * (1.0 - lam * lam) + 0.39;
+            double t = d * tscale / (sigma * lam); /* t of ibm_alpha() times alpha_scale */
+            x[k] = t < -ALPHA_TABLE ? -ALPHA_TABLE : (t > ALPHA_TABLE ? ALPHA_TABLE : t);
+            x[k] = rr > 0.0 ? x[k] : -ALPHA_TABLE;
+        }
+        for (int k = 0; k < n; k++) {
+            double xa = fabs(x[k]);
+            int i = (int)xa;
+            double f = alpha_table[i] + (xa - i) * (alpha_table[i + 1] - alpha_table[i]);
+            al[k0 + k] = x[k] < 0.0 ? 1.0 - f : f;
+        }
+    }
+}
+
+/* Grid line of a run: (component, local x index[, global y index]). */
+static inline int32_t run_line(const grid_t *g, int c, long m0)
+{
+    int il = ibm_node_i(g, m0);
+    if (g->dim == 2) return (int32_t)(c * g->nxl + il);
+    int jw = (int)((m0 - G_IDX(g, il, 0, 0)) / g->sy);
+    return (int32_t)(((long)c * g->nxl + il) * g->n[1] + jw);
+}
+
+/* Record a run of sphere b->p (its α comes later, in storage order). */
 static void add_run(void *ctx, int c, long m0, int len, const double r0[3], double h)
 {
+    (void)h; /* = hcell[c][i] */
     build_ctx_t *b = ctx;
     ibm_priv_t *q = b->q;
     if (q->nruns == q->cap_runs) {
         q->cap_runs = q->cap_runs ? 2 * q->cap_runs : 1024;
-        q->runs = realloc(q->runs, (size_t)q->cap_runs * sizeof *q->runs);
-        if (!q->runs) die_local("immersed boundary: out of memory for %ld runs", q->cap_runs);
+        q->runs_tmp = realloc(q->runs_tmp, (size_t)q->cap_runs * sizeof *q->runs_tmp);
+        if (!q->runs_tmp) die_local("immersed boundary: out of memory for %ld runs", q->cap_runs);
     }
-    while (q->nalpha + len > q->cap_alpha) {
-        q->cap_alpha = q->cap_alpha ? 2 * q->cap_alpha : 16384;
-        q->alpha = realloc(q->alpha, (size_t)q->cap_alpha * sizeof *q->alpha);
-        if (!q->alpha) die_local("immersed boundary: out of memory for %ld node entries", q->cap_alpha);
-    }
-    ibm_run_t *run = &q->runs[q->nruns++];
+    ibm_run_t *run = &q->runs_tmp[q->nruns++];
     memcpy(run->r0, r0, sizeof run->r0);
     run->m0 = (int32_t)m0;
-    run->a0 = (int32_t)q->nalpha;
     run->len = (int16_t)len;
     run->c = (uint8_t)c;
-    run->shared = (uint8_t)segment_shared(b->ibm, b->p, r0, len, h);
-    if (run->shared) q->nshared += len;
-    double r[3] = {r0[0], r0[1], r0[2]};
-    for (int k = 0; k < len; k++, r[q->rdir] += q->rstep)
-        q->alpha[q->nalpha++] = alpha_at(b->R, b->band, b->retraction, r, h);
+    run->p = b->p;
+    run->line = run_line(b->ibm->g, c, m0);
 }
 
-/* Neighbours: pairs closer than the sum of the radii and of both bands in
- * the largest cell, plus a cell; each periodic image of the other sphere
- * that close counts (in a box shorter than twice that distance, more than
- * the nearest one). */
-static void find_neighbours(const ibm_t *ibm)
+/* Sort the generated runs into storage order (by grid line, each line's
+ * runs by m0, ties in generation order) and merge them into the
+ * forced nodes: the runs of a line that overlap or touch become one node
+ * run, each node once; every sphere run gets the index of its first node
+ * (u0). */
+static void sort_and_merge_runs(ibm_t *ibm)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
-    double hmax = g->dy;
-    if (g->dim == 3) hmax = hmax > g->dz ? hmax : g->dz;
-    for (int i = 0; i < g->n[0]; i++) hmax = hmax > g->gdxf[i] ? hmax : g->gdxf[i];
-    double m = 2 * (ibm_band_halfwidth() + 0.5) * hmax;
-    long k = 0;
-    for (int p = 0; p < ibm->n; p++) {
-        q->nb_start[p] = (int)k;
-        for (int o = 0; o < ibm->n; o++) {
-            if (o == p) continue;
-            double lim = ibm->s[p].radius + ibm->s[o].radius + m, dmin[3] = {0, 0, 0};
-            int top[3] = {0, 0, 0}, im[3];
-            for (int d = 0; d < g->dim; d++) {
-                dmin[d] = ibm->s[o].xa[d] - ibm->s[p].xa[d];
-                if (g->periodic[d]) {
-                    dmin[d] -= g->L[d] * round(dmin[d] / g->L[d]);
-                    top[d] = g->L[d] < 2 * lim; /* the next images may be close too */
-                }
-            }
-            for (im[0] = -top[0]; im[0] <= top[0]; im[0]++)
-                for (im[1] = -top[1]; im[1] <= top[1]; im[1]++)
-                    for (im[2] = -top[2]; im[2] <= top[2]; im[2]++) {
-                        double dd[3], r2 = 0;
-                        for (int d = 0; d < 3; d++) {
-                            dd[d] = dmin[d] + im[d] * g->L[d];
-                            r2 += dd[d] * dd[d];
-                        }
-                        if (r2 >= lim * lim) continue;
-                        if (k == q->nb_cap) {
-                            q->nb_cap = q->nb_cap ? 2 * q->nb_cap : 256;
-                            q->nb = realloc(q->nb, (size_t)q->nb_cap * sizeof *q->nb);
-                        }
-                        q->nb[k].o = o;
-                        memcpy(q->nb[k].d, dd, sizeof dd);
-                        k++;
-                    }
+    long st = q->rstride, nlines = (long)g->dim * g->nxl * (g->dim == 3 ? g->n[1] : 1);
+    if (q->nruns > q->cap_next || !q->runs) { /* (allocated even when empty: memset of NULL is undefined) */
+        q->cap_next = q->cap_runs;
+        free(q->run_order);
+        free(q->runs);
+        q->run_order = xcalloc((size_t)q->cap_next, sizeof *q->run_order);
+        q->runs = xcalloc((size_t)q->cap_next, sizeof *q->runs);
+    }
+    /* counting sort by line (stable), then each line's few runs by m0
+     * (insertion sort, stable): run_order[line_head[l] .. line_head[l+1]) */
+    memset(q->line_head, 0, (size_t)(nlines + 1) * sizeof *q->line_head);
+    for (long ir = 0; ir < q->nruns; ir++) q->line_head[q->runs_tmp[ir].line + 1]++;
+    for (long l = 0; l < nlines; l++) q->line_head[l + 1] += q->line_head[l];
+    for (long ir = 0; ir < q->nruns; ir++) q->run_order[q->line_head[q->runs_tmp[ir].line]++] = (int32_t)ir;
+    for (long l = nlines; l > 0; l--) q->line_head[l] = q->line_head[l - 1];
+    q->line_head[0] = 0;
+    for (long l = 0; l < nlines; l++) {
+        int32_t *o = q->run_order + q->line_head[l];
+        int cnt = q->line_head[l + 1] - q->line_head[l];
+        for (int i = 1; i < cnt; i++) {
+            int32_t v = o[i], j = i;
+            for (; j > 0 && q->runs_tmp[o[j - 1]].m0 > q->runs_tmp[v].m0; j--) o[j] = o[j - 1];
+            o[j] = v;
         }
     }
-    q->nb_start[ibm->n] = (int)k;
+    long nr = 0;
+    q->n_nruns = 0;
+    q->nnodes = 0;
+    for (long l = 0; l < nlines; l++) {
+        int32_t e = q->line_head[l], end = q->line_head[l + 1];
+        while (e < end) {
+            long ms = q->runs_tmp[q->run_order[e]].m0, me = ms - st, n0 = q->nnodes; /* first and last node */
+            for (; e < end && q->runs_tmp[q->run_order[e]].m0 <= me + st; e++) {
+                ibm_run_t *o = &q->runs[nr++];
+                *o = q->runs_tmp[q->run_order[e]];
+                o->u0 = (int32_t)(n0 + (o->m0 - ms) / st);
+                long oe = o->m0 + (o->len - 1) * st;
+                if (oe > me) me = oe;
+            }
+            if (q->n_nruns == q->cap_nruns) {
+                q->cap_nruns = q->cap_nruns ? 2 * q->cap_nruns : 1024;
+                q->nruns_f = realloc(q->nruns_f, (size_t)q->cap_nruns * sizeof *q->nruns_f);
+                if (!q->nruns_f) die_local("immersed boundary: out of memory for %ld node runs", q->cap_nruns);
+            }
+            ibm_node_run_t *n = &q->nruns_f[q->n_nruns++];
+            n->m0 = (int32_t)ms;
+            n->n0 = (int32_t)n0;
+            n->len = (int32_t)((me - ms) / st + 1);
+            n->c = q->runs[nr - 1].c;
+            q->nnodes += n->len;
+        }
+    }
+}
+
+/* α of every run entry, in storage order, and Σ_p α_p at each forced node. */
+static void compute_alpha(ibm_t *ibm)
+{
+    ibm_priv_t *q = ibm_priv(ibm);
+    const grid_t *g = ibm->g;
+    double retraction = ibm->prm.retraction;
+    long n = 0;
+    for (long ir = 0; ir < q->nruns; ir++) n += q->runs[ir].len;
+    if (n > q->cap_alpha || !q->alpha) {
+        q->cap_alpha = n + n / 4;
+        free(q->alpha);
+        q->alpha = xcalloc((size_t)q->cap_alpha, sizeof *q->alpha);
+    }
+    if (q->nnodes > q->cap_nodes || !q->node_asum) {
+        q->cap_nodes = q->nnodes + q->nnodes / 4;
+        free(q->node_asum);
+        free(q->node_target);
+        free(q->node_imp);
+        q->node_asum = xcalloc((size_t)q->cap_nodes, sizeof(double));
+        q->node_target = xcalloc((size_t)q->cap_nodes, sizeof(double));
+        q->node_imp = xcalloc((size_t)q->cap_nodes, sizeof(double));
+    }
+    memset(q->node_asum, 0, (size_t)q->nnodes * sizeof(double));
+    /* node_imp counts the spheres at each node meanwhile */
+    memset(q->node_imp, 0, (size_t)q->nnodes * sizeof(double));
+    q->nalpha = 0;
+    for (long ir = 0; ir < q->nruns; ir++) {
+        ibm_run_t *run = &q->runs[ir];
+        double h = q->hcell[run->c][ibm_node_i(g, run->m0)], *al = q->alpha + q->nalpha;
+        double *A = q->node_asum + run->u0, *cnt = q->node_imp + run->u0;
+        run->a0 = (int32_t)q->nalpha;
+        alpha_run(ibm->s[run->p].radius - retraction * h, run->r0, q->rdir, q->rstep, h, run->len, al);
+        for (int k = 0; k < run->len; k++) {
+            A[k] += al[k];
+            cnt[k] += 1.0;
+        }
+        q->nalpha += run->len;
+    }
+    double shared = 0.0;
+    for (long j = 0; j < q->nnodes; j++) shared += q->node_imp[j] > 1.0 ? q->node_imp[j] : 0.0;
+    q->nshared = (long)shared;
 }
 
 void ibm_build_nodes(ibm_t *ibm)
 {
     ibm_priv_t *q = ibm_priv(ibm);
-    build_ctx_t b = {.ibm = ibm, .q = q, .band = ibm_band_halfwidth(), .retraction = ibm->prm.retraction};
+    build_ctx_t b = {.ibm = ibm, .q = q};
+    if (alpha_tmax == 0.0) alpha_table_init();
     q->nruns = 0;
-    q->nalpha = 0;
-    q->nshared = 0;
-    find_neighbours(ibm);
-    for (int p = 0; p < ibm->n; p++) {
-        q->start[p] = q->nruns;
-        b.p = p;
-        b.R = ibm->s[p].radius;
-        for (int c = 0; c < ibm->g->dim; c++) for_sphere_segments(ibm, &ibm->s[p], c, add_run, &b);
-    }
-    q->start[ibm->n] = q->nruns;
+    for (b.p = 0; b.p < ibm->n; b.p++)
+        for (int c = 0; c < ibm->g->dim; c++) for_sphere_segments(ibm, &ibm->s[b.p], c, add_run, &b);
+    sort_and_merge_runs(ibm);
+    compute_alpha(ibm);
+    q->built = 1;
+    q->targets_valid = 0;
     ibm->nodes_forced = q->nalpha;
     ibm->nodes_shared = q->nshared;
 }

@@ -46,6 +46,7 @@
  *     Δu = g Δt_k − ρ ∫ f dV Δt_k / ((ρ_p − ρ) V_p).
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "ibm_internal.h"
@@ -69,131 +70,152 @@ static inline double forcing_beta(double a, double dt, double tau)
     return a * dt / ((1.0 - a) * tau + a * dt);
 }
 
-/* One forcing of the current velocity; adds the impulse ∫ f dV Δt_k of each
- * sphere and its moment to sum[IBM_FIMP..].  A run that no other sphere's
- * band reaches (run->shared = 0, alpha.c) is forced directly; the shared
- * runs go through the dense scratch, where a node takes α = min(1, Σα_p),
- * the α-weighted mean velocity, and each sphere the share α_p/Σα of its
- * impulse. */
-static void force_pass(ibm_t *ibm, double dt)
+/* The forcing works on the merged node lists of alpha.c: each forced node
+ * once, with α = min(1, Σ_p α_p) and the target velocity the α-weighted
+ * mean Ū = Σ_p (α_p/Σα) U_p(r_p) of the rigid-body velocities of the
+ * spheres whose band reaches it; each sphere then takes the share α_p/Σα
+ * of the node's impulse.  (A node of one sphere: Ū = U_p and its whole
+ * impulse, exactly.)  Three passes: targets (set_targets), forcing of the
+ * nodes (force_nodes, streaming over the node runs, as often as there are
+ * forcings), and each sphere's share of the accumulated impulses
+ * (sphere_sums). */
+
+/* Ū at every forced node from the spheres' current velocities, and the
+ * accumulated impulses reset.  Ū is kept when neither the node lists nor
+ * any sphere's velocity changed since it was set (spheres at rest, a fixed
+ * bed: the pass is skipped). */
+static void set_targets(ibm_t *ibm)
+{
+    ibm_priv_t *q = ibm_priv(ibm);
+    double step = q->rstep;
+    int rd = q->rdir;
+    q->imp_fresh = 1; /* the next forcing starts the accumulation */
+    int same = q->targets_valid;
+    for (int p = 0; p < ibm->n && same; p++)
+        same = !memcmp(q->target_vel + 6 * p, ibm->s[p].u, 3 * sizeof(double)) &&
+               !memcmp(q->target_vel + 6 * p + 3, ibm->s[p].omega, 3 * sizeof(double));
+    if (same) return;
+    for (int p = 0; p < ibm->n; p++) {
+        memcpy(q->target_vel + 6 * p, ibm->s[p].u, 3 * sizeof(double));
+        memcpy(q->target_vel + 6 * p + 3, ibm->s[p].omega, 3 * sizeof(double));
+    }
+    q->targets_valid = 1;
+    memset(q->node_target, 0, (size_t)q->nnodes * sizeof(double));
+    for (long ir = 0; ir < q->nruns; ir++) {
+        const ibm_run_t *run = &q->runs[ir];
+        const ibm_sphere_t *s = &ibm->s[run->p];
+        const double *al = q->alpha + run->a0, *A = q->node_asum + run->u0;
+        double *T = q->node_target + run->u0, r[3] = {run->r0[0], run->r0[1], run->r0[2]};
+        for (int k = 0; k < run->len; k++, r[rd] += step)
+            if (al[k] > 0.0) T[k] += al[k] / A[k] * ibm_rigid_velocity(s, run->c, r);
+    }
+}
+
+/* One forcing u ← u + β (Ū − u) of every forced node, the impulse added
+ * to node_imp (stored by the first forcing after set_targets). */
+static void force_nodes(ibm_t *ibm, double dt)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
-    fluid_t *f = ibm->f;
-    double kappa = ibm->prm.forcing_time, nu = f->prm.nu, step = q->rstep;
+    double kappa = ibm->prm.forcing_time, nu = ibm->f->prm.nu;
     long st = q->rstride;
-    int rd = q->rdir, shared = 0;
-    for (int p = 0; p < ibm->n; p++) {
-        const ibm_sphere_t *s = &ibm->s[p];
-        double *sum = q->sum + (long)p * IBM_NSUM, J[3] = {0, 0, 0}, T[3] = {0, 0, 0};
-        for (long ir = q->start[p]; ir < q->start[p + 1]; ir++) {
-            const ibm_run_t *run = &q->runs[ir];
-            int c = run->c;
-            if (run->shared) {
-                /* Σ α_p and Σ α_p U_p for the shared pass below */
-                double *A = q->asum[c] + run->m0, *B = q->aux[c] + run->m0, r[3] = {run->r0[0], run->r0[1], run->r0[2]};
-                for (int k = 0; k < run->len; k++, r[rd] += step) {
-                    double a = q->alpha[run->a0 + k];
-                    A[k * st] += a;
-                    B[k * st] += a * ibm_rigid_velocity(s, c, r);
+    int fast = kappa <= 0 && st == 1, first = q->imp_fresh;
+    q->imp_fresh = 0;
+    if (first && !fast) memset(q->node_imp, 0, (size_t)q->nnodes * sizeof(double));
+    for (long ir = 0; ir < q->n_nruns; ir++) {
+        const ibm_node_run_t *nr = &q->nruns_f[ir];
+        double *u = ibm->f->u[nr->c] + nr->m0, *J = q->node_imp + nr->n0;
+        const double *A = q->node_asum + nr->n0, *T = q->node_target + nr->n0;
+        int len = nr->len;
+        if (fast) { /* the seed's β = α, unit stride: vectorised; the
+                     * first forcing writes J without reading it */
+            if (first)
+                for (int k = 0; k < len; k++) {
+                    double imp = (A[k] < 1.0 ? A[k] : 1.0) * (T[k] - u[k]);
+                    u[k] += imp;
+                    J[k] = imp;
                 }
-                shared = 1;
-                continue;
-            }
-            int i = ibm_node_i(g, run->m0);
-            double *u = f->u[c] + run->m0;
-            const double *al = q->alpha + run->a0;
-            double h = q->hcell[c][i], tau = kappa > 0 ? kappa * h * h / nu : 0.0, vol = q->vol[c][i];
-            double r[3] = {run->r0[0], run->r0[1], run->r0[2]}, jr = 0, t[3];
-            for (int k = 0; k < run->len; k++, r[rd] += step) {
-                double imp = forcing_beta(al[k], dt, tau) * (ibm_rigid_velocity(s, c, r) - u[k * st]);
+            else
+                for (int k = 0; k < len; k++) {
+                    double imp = (A[k] < 1.0 ? A[k] : 1.0) * (T[k] - u[k]);
+                    u[k] += imp;
+                    J[k] += imp;
+                }
+        } else if (kappa > 0) {
+            double h = q->hcell[nr->c][ibm_node_i(g, nr->m0)], tau = kappa * h * h / nu;
+            for (int k = 0; k < len; k++) {
+                double imp = forcing_beta(A[k] < 1.0 ? A[k] : 1.0, dt, tau) * (T[k] - u[k * st]);
                 u[k * st] += imp;
-                jr += imp;
-                cross_axis(r, c, imp, t);
-                for (int d = 0; d < 3; d++) T[d] += t[d] * vol;
+                J[k] += imp;
             }
-            J[c] += jr * vol;
-        }
-        for (int d = 0; d < 3; d++) {
-            sum[IBM_FIMP + d] += J[d];
-            sum[IBM_TIMP + d] += T[d];
-        }
-    }
-    if (!shared) return;
-    /* force each shared node once (u ← u + β (U − u)); keep the impulse in
-     * aux and mark the node done by the sign of asum */
-    for (long ir = 0; ir < q->nruns; ir++) {
-        const ibm_run_t *run = &q->runs[ir];
-        if (!run->shared) continue;
-        int c = run->c, i = ibm_node_i(g, run->m0);
-        double h = q->hcell[c][i], tau = kappa > 0 ? kappa * h * h / nu : 0.0;
-        double *A = q->asum[c] + run->m0, *B = q->aux[c] + run->m0, *u = f->u[c] + run->m0;
-        for (int k = 0; k < run->len; k++) {
-            double Ak = A[k * st];
-            if (Ak <= 0.0) continue;
-            double imp = forcing_beta(Ak < 1.0 ? Ak : 1.0, dt, tau) * (B[k * st] / Ak - u[k * st]);
-            u[k * st] += imp;
-            B[k * st] = imp;
-            A[k * st] = -Ak;
-        }
-    }
-    /* each sphere's share α_p/Σα of the impulse, and its moment */
-    for (int p = 0; p < ibm->n; p++) {
-        double *sum = q->sum + (long)p * IBM_NSUM, t[3];
-        for (long ir = q->start[p]; ir < q->start[p + 1]; ir++) {
-            const ibm_run_t *run = &q->runs[ir];
-            if (!run->shared) continue;
-            int c = run->c;
-            double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]};
-            const double *A = q->asum[c] + run->m0, *B = q->aux[c] + run->m0;
-            for (int k = 0; k < run->len; k++, r[rd] += step) {
-                if (A[k * st] >= 0.0) continue; /* α = 0 at the end of a run: not forced */
-                double J = q->alpha[run->a0 + k] / -A[k * st] * B[k * st] * vol;
-                sum[IBM_FIMP + c] += J;
-                cross_axis(r, c, J, t);
-                for (int d = 0; d < 3; d++) sum[IBM_TIMP + d] += t[d];
+        } else {
+            for (int k = 0; k < len; k++) {
+                double imp = (A[k] < 1.0 ? A[k] : 1.0) * (T[k] - u[k * st]);
+                u[k * st] += imp;
+                J[k] += imp;
             }
-        }
-    }
-    for (long ir = 0; ir < q->nruns; ir++) {
-        const ibm_run_t *run = &q->runs[ir];
-        if (!run->shared) continue;
-        for (int k = 0; k < run->len; k++) {
-            q->asum[run->c][run->m0 + k * st] = 0.0;
-            q->aux[run->c][run->m0 + k * st] = 0.0;
         }
     }
 }
 
-/* ∫ α_p u dV and ∫ α_p r × u dV of every sphere on this rank into
- * sum[IBM_MOM..IBM_ANG+2]. */
-void ibm_momentum(ibm_t *ibm, double *sum_all)
+/* Per-sphere sums over the runs (in storage order, each sphere's sums
+ * carried from run to run), overwritten in sum_all:
+ *  impulses: each sphere's share α_p/Σα of the accumulated forcing
+ *            impulses, ∫ f dV Δt and its moment, into IBM_FIMP..IBM_TIMP+2;
+ *  momentum: ∫ α_p u dV and ∫ α_p r × u dV into IBM_MOM..IBM_ANG+2.
+ * Along a run only the run coordinate z of r = r⊥ + z e_run varies, so the
+ * moment of the values a_k e_c of a run is r⊥ × e_c Σa_k + e_run × e_c
+ * Σ z_k a_k: two sums per run instead of a cross product per node. */
+static void sphere_sums(ibm_t *ibm, double *sum_all, int impulses, int momentum)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
     long st = q->rstride;
+    double step = q->rstep, e_run[3] = {0, 0, 0};
     int rd = q->rdir;
-    for (int p = 0; p < ibm->n; p++) {
-        double *sum = sum_all + (long)p * IBM_NSUM, I[3] = {0, 0, 0}, Lm[3] = {0, 0, 0}, t[3];
-        for (long ir = q->start[p]; ir < q->start[p + 1]; ir++) {
-            const ibm_run_t *run = &q->runs[ir];
-            int c = run->c;
-            const double *u = ibm->f->u[c] + run->m0, *al = q->alpha + run->a0;
-            double vol = q->vol[c][ibm_node_i(g, run->m0)], r[3] = {run->r0[0], run->r0[1], run->r0[2]}, s = 0;
-            for (int k = 0; k < run->len; k++, r[rd] += q->rstep) {
-                double a = al[k] * u[k * st];
-                s += a;
-                cross_axis(r, c, a * vol, t);
-                for (int d = 0; d < 3; d++) Lm[d] += t[d];
-            }
-            I[c] += s * vol;
+    e_run[rd] = 1.0;
+    for (int p = 0; p < ibm->n; p++)
+        for (int d = 0; d < 6; d++) {
+            if (impulses) sum_all[(long)p * IBM_NSUM + IBM_FIMP + d] = 0.0;
+            if (momentum) sum_all[(long)p * IBM_NSUM + IBM_MOM + d] = 0.0;
         }
-        for (int d = 0; d < 3; d++) {
-            sum[IBM_MOM + d] = I[d];
-            sum[IBM_ANG + d] = Lm[d];
+    for (long ir = 0; ir < q->nruns; ir++) {
+        const ibm_run_t *run = &q->runs[ir];
+        int c = run->c;
+        double *sum = sum_all + (long)run->p * IBM_NSUM, t0[3], t1[3];
+        const double *al = q->alpha + run->a0, *A = q->node_asum + run->u0, *imp = q->node_imp + run->u0;
+        const double *u = ibm->f->u[c] + run->m0;
+        double vol = q->vol[c][ibm_node_i(g, run->m0)], z0 = run->r0[rd], rperp[3] = {run->r0[0], run->r0[1], run->r0[2]};
+        double j0 = 0, j1 = 0, m0 = 0, m1 = 0;
+        rperp[rd] = 0.0;
+        if (impulses)
+            for (int k = 0; k < run->len; k++) {
+                double share = al[k] > 0.0 ? al[k] / A[k] * imp[k] : 0.0;
+                j0 += share;
+                j1 += (z0 + k * step) * share;
+            }
+        if (momentum)
+            for (int k = 0; k < run->len; k++) {
+                double a = al[k] * u[k * st];
+                m0 += a;
+                m1 += (z0 + k * step) * a;
+            }
+        if (impulses) {
+            cross_axis(rperp, c, j0 * vol, t0);
+            cross_axis(e_run, c, j1 * vol, t1);
+            sum[IBM_FIMP + c] += j0 * vol;
+            for (int d = 0; d < 3; d++) sum[IBM_TIMP + d] += t0[d] + t1[d];
+        }
+        if (momentum) {
+            cross_axis(rperp, c, m0 * vol, t0);
+            cross_axis(e_run, c, m1 * vol, t1);
+            sum[IBM_MOM + c] += m0 * vol;
+            for (int d = 0; d < 3; d++) sum[IBM_ANG + d] += t0[d] + t1[d];
         }
     }
 }
+
+void ibm_momentum(ibm_t *ibm, double *sum_all) { sphere_sums(ibm, sum_all, 0, 1); }
 
 static void reduce_sums(ibm_t *ibm)
 {
@@ -218,28 +240,132 @@ void ibm_rebuild_geometry(ibm_t *ibm)
     ibm->wall_integrals += wtime() - w1;
 }
 
+/* The shortest displacement from a to b (periodic directions: the nearest
+ * image). */
+static void displacement(const grid_t *g, const double a[3], const double b[3], double dx[3])
+{
+    for (int d = 0; d < 3; d++) {
+        dx[d] = b[d] - a[d];
+        if (d < g->dim && g->periodic[d]) dx[d] -= g->L[d] * round(dx[d] / g->L[d]);
+    }
+}
+
+/* Do all spheres keep their position and velocity over the fluid step
+ * (fixed spheres, and external ones, which the coupling moves between
+ * steps)?  Then the solid fraction and the targets Ū stay as they are over
+ * the three stages, the forcing impulses accumulate at the nodes, and the
+ * hydrodynamic impulse of the step is taken once, at its end: the
+ * momentum difference telescopes, Σ_k (I^k − I^{k−1}) = I^3 − I^0
+ * (docs/theory.md §6b). */
+static int step_frozen(const ibm_t *ibm)
+{
+    for (int p = 0; p < ibm->n; p++)
+        if (ibm->s[p].kind != IBM_FIXED && ibm->s[p].kind != IBM_EXTERNAL) return 0;
+    return 1;
+}
+
+/* Fixed and external spheres set to new centres x from outside (the
+ * coupling, between steps): α at the new centres, and the momentum I^0, L^0
+ * from which the next step's impulse is counted.  Over a move δ = x − xa,
+ * the fluid momentum inside the sphere changes from I_old (old α, carried
+ * from the end of the last step) to I_new (new α).  The part of the move
+ * that the last step's velocity predicts, δ_p = xpred − xa, is the motion
+ * of the sphere during that step, which a sphere moved within the step
+ * (prescribed) counts in its force; the rest (e.g. a collision resolved by
+ * the DEM within the step) is not counted, as when α is rebuilt at the new
+ * centre.  Along the move, I^0 = I_old + (1 − λ)(I_new − I_old) with
+ * λ = δ_p·δ/|δ|² (λ = 1: the whole change is counted, the impulses
+ * telescope over the steps; λ = 0: I^0 = I_new), L likewise about the new
+ * centre (L_old − δ × I_old).  Returns whether any sphere moved (then the
+ * node lists are rebuilt here). */
+static int carry_external_moves(ibm_t *ibm)
+{
+    ibm_priv_t *q = ibm_priv(ibm);
+    int moved = 0;
+    double *lam = xcalloc((size_t)ibm->n, sizeof(double)), *old = xcalloc(6 * (size_t)ibm->n, sizeof(double));
+    char *mv = xcalloc((size_t)ibm->n, 1);
+    for (int p = 0; p < ibm->n; p++) {
+        ibm_sphere_t *s = &ibm->s[p];
+        if ((s->kind != IBM_FIXED && s->kind != IBM_EXTERNAL) || !memcmp(s->xa, s->x, sizeof s->x)) continue;
+        double dx[3], dp[3], *I = q->mom_prev + 6 * p, *L = I + 3, dd = 0, dpd = 0;
+        displacement(ibm->g, s->xa, s->x, dx);
+        displacement(ibm->g, s->xa, s->xpred, dp);
+        for (int d = 0; d < 3; d++) dd += dx[d] * dx[d], dpd += dp[d] * dx[d];
+        lam[p] = dd > 0 ? dpd / dd : 0.0;
+        L[0] -= dx[1] * I[2] - dx[2] * I[1];
+        L[1] -= dx[2] * I[0] - dx[0] * I[2];
+        L[2] -= dx[0] * I[1] - dx[1] * I[0];
+        memcpy(old + 6 * p, I, 6 * sizeof(double));
+        memcpy(s->xa, s->x, sizeof s->x);
+        moved = mv[p] = 1;
+    }
+    if (moved) {
+        ibm_build_nodes(ibm);
+        ibm_momentum(ibm, q->sum);
+        reduce_sums(ibm);
+        for (int p = 0; p < ibm->n; p++)
+            if (mv[p])
+                for (int d = 0; d < 6; d++) {
+                    double now = q->sum[(long)p * IBM_NSUM + IBM_MOM + d];
+                    q->mom_prev[6 * p + d] = old[6 * p + d] + (1.0 - lam[p]) * (now - old[6 * p + d]);
+                }
+    }
+    free(lam);
+    free(old);
+    free(mv);
+    return moved;
+}
+
+/* Spheres moved from outside (coupling).  When every sphere is fixed or
+ * external, the move is applied at the start of the next fluid step
+ * (carry_external_moves from ibm_stage_force): between steps the solid
+ * fraction stays the one the last step used, so a checkpoint or a rollback
+ * taken there holds the centres (xa) of the carried momentum and a restart
+ * rebuilds it exactly.  Otherwise at once: free and prescribed spheres take
+ * the momentum at their new solid fraction. */
 void ibm_update_geometry(ibm_t *ibm)
 {
+    ibm_priv_t *q = ibm_priv(ibm);
+    if (!q->built) {
+        for (int p = 0; p < ibm->n; p++) memcpy(ibm->s[p].xa, ibm->s[p].x, sizeof ibm->s[p].x);
+        ibm_rebuild_geometry(ibm);
+        return;
+    }
+    if (step_frozen(ibm)) return;
+    carry_external_moves(ibm);
+    double *keep = xcalloc(6 * (size_t)ibm->n, sizeof(double));
+    memcpy(keep, q->mom_prev, 6 * (size_t)ibm->n * sizeof(double));
     for (int p = 0; p < ibm->n; p++) memcpy(ibm->s[p].xa, ibm->s[p].x, sizeof ibm->s[p].x);
     ibm_rebuild_geometry(ibm);
+    for (int p = 0; p < ibm->n; p++)
+        if (ibm->s[p].kind == IBM_FIXED || ibm->s[p].kind == IBM_EXTERNAL)
+            memcpy(q->mom_prev + 6 * p, keep + 6 * p, 6 * sizeof(double));
+    free(keep);
 }
 
 void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
 {
     ibm_t *ibm = ctx;
     ibm_priv_t *q = ibm_priv(ibm);
-    double w0 = wtime();
     if (stage == 0) {
         q->t_step = 0.0;
         q->t_stage0 = f->time;
         memset(q->imp_step, 0, (size_t)ibm->n * 6 * sizeof(double));
+        q->frozen = step_frozen(ibm);
+        /* the moves made since the last step (ibm_update_geometry) */
+        double w0 = wtime();
+        if (q->frozen) carry_external_moves(ibm);
+        ibm->wall_alpha += wtime() - w0;
     }
-    memset(q->sum, 0, (size_t)ibm->n * IBM_NSUM * sizeof(double));
+    double w0 = wtime();
+    if (stage == 0 || !q->frozen) set_targets(ibm);
     for (int it = 0; it < ibm->prm.forcing_iterations; it++) {
-        force_pass(ibm, dt_stage);
+        force_nodes(ibm, dt_stage);
         fluid_stage_project(f, dt_stage);
     }
-    force_pass(ibm, dt_stage);
+    force_nodes(ibm, dt_stage);
+    /* the impulses of the stage, before the solid fraction moves */
+    if (!q->frozen) sphere_sums(ibm, q->sum, 1, 0);
     ibm->wall_forcing += wtime() - w0;
 }
 
@@ -263,7 +389,8 @@ static void predict_centre(const ibm_t *ibm, ibm_sphere_t *s, double dt, double 
 {
     double u1[3], w1[3];
     switch (s->kind) {
-    case IBM_FIXED: memcpy(s->xa, s->x, sizeof s->xa); return;
+    case IBM_FIXED:
+    case IBM_EXTERNAL: memcpy(s->xa, s->x, sizeof s->xa); return; /* moved between steps only */
     case IBM_PRESCRIBED:
         ibm_prescribed_velocity(ibm, s, t_end, u1, w1);
         mask_geometry(ibm->g, u1, w1);
@@ -303,9 +430,12 @@ static void update_sphere(ibm_t *ibm, int p, double dt, double t_end, double J[3
     double u0[3], w0[3], du[3] = {0, 0, 0}, dw[3] = {0, 0, 0};
     memcpy(u0, s->u, sizeof u0);
     memcpy(w0, s->omega, sizeof w0);
+    /* the reference point of L moves with the solid fraction: not so for
+     * fixed and external spheres, whose α stays where it is over the step */
+    double dt_ref = s->kind == IBM_FIXED || s->kind == IBM_EXTERNAL ? 0.0 : dt;
     for (int c = 0; c < 3; c++) {
         J[c] = rho * (sum[IBM_MOM + c] - prev[c] - sum[IBM_FIMP + c]);
-        K[c] = rho * (sum[IBM_ANG + c] - prev[3 + c] + dt * uxI[c] - sum[IBM_TIMP + c]);
+        K[c] = rho * (sum[IBM_ANG + c] - prev[3 + c] + dt_ref * uxI[c] - sum[IBM_TIMP + c]);
     }
     switch (s->kind) {
     case IBM_FREE: {
@@ -367,6 +497,25 @@ void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx)
     ibm_priv_t *q = ibm_priv(ibm);
     q->t_step += dt_stage;
     double t_end = q->t_stage0 + q->t_step;
+    if (q->frozen) {
+        /* nothing moves within the step: one impulse for the whole step */
+        if (stage < 2) return;
+        double w0 = wtime();
+        sphere_sums(ibm, q->sum, 1, 1);
+        reduce_sums(ibm);
+        for (int p = 0; p < ibm->n; p++) {
+            double J[3], K[3];
+            update_sphere(ibm, p, q->t_step, t_end, J, K);
+            for (int d = 0; d < 3; d++) {
+                ibm->s[p].force[d] = J[d] / q->t_step;
+                ibm->s[p].torque[d] = K[d] / q->t_step;
+                ibm->s[p].xpred[d] = ibm->s[p].xa[d] + q->t_step * ibm->s[p].u[d];
+            }
+            for (int d = 0; d < 6; d++) q->mom_prev[6 * p + d] = q->sum[(long)p * IBM_NSUM + IBM_MOM + d];
+        }
+        ibm->wall_integrals += wtime() - w0;
+        return;
+    }
     /* move the solid fraction to the predicted centres */
     int moved = 0;
     for (int p = 0; p < ibm->n; p++) {
@@ -396,6 +545,7 @@ void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx)
             for (int d = 0; d < 3; d++) {
                 ibm->s[p].force[d] = q->imp_step[6 * p + d] / q->t_step;
                 ibm->s[p].torque[d] = q->imp_step[6 * p + 3 + d] / q->t_step;
+                ibm->s[p].xpred[d] = ibm->s[p].xa[d] + q->t_step * ibm->s[p].u[d];
             }
     ibm->wall_alpha += w1 - w0;
     ibm->wall_integrals += wtime() - w1;

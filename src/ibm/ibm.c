@@ -189,10 +189,9 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
                 p + 1);
         if (ibm->s[p].kind != IBM_PRESCRIBED) ibm->s[p].history = -1;
         if (g->dim == 2) ibm->s[p].x[2] = 0.0;
+        memcpy(ibm->s[p].xpred, ibm->s[p].x, sizeof ibm->s[p].x);
     }
     for (int c = 0; c < g->dim; c++) {
-        q->asum[c] = field_alloc(g);
-        q->aux[c] = field_alloc(g);
         q->vol[c] = (double *)xcalloc((size_t)g->nxl + 2, sizeof(double)) + 1;
         q->hcell[c] = (double *)xcalloc((size_t)g->nxl + 2, sizeof(double)) + 1;
         for (int i = 0; i < g->nxl; i++) {
@@ -202,13 +201,13 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
         }
     }
     size_t nn = (size_t)(n > 0 ? n : 1);
-    q->start = xcalloc(nn + 1, sizeof(long));
-    q->nb_start = xcalloc(nn + 1, sizeof(int));
+    q->line_head = xcalloc((size_t)g->dim * (size_t)g->nxl * (size_t)(g->dim == 3 ? g->n[1] : 1) + 1, sizeof(int32_t));
     q->rdir = g->dim == 3 ? 2 : 1;
     q->rstride = g->dim == 3 ? 1 : g->sy;
     q->rstep = g->dim == 3 ? g->dz : g->dy;
     q->sum = xcalloc(nn * IBM_NSUM, sizeof(double));
     q->mom_prev = xcalloc(nn * 6, sizeof(double));
+    q->target_vel = xcalloc(nn * 6, sizeof(double));
     q->imp_step = xcalloc(nn * 6, sizeof(double));
     f->stage_hook = ibm_stage_force;
     f->stage_end_hook = ibm_stage_end;
@@ -227,8 +226,6 @@ void ibm_free(ibm_t *ibm)
         ibm->f->hook_ctx = NULL;
     }
     for (int c = 0; c < 3; c++) {
-        free(q->asum[c]);
-        free(q->aux[c]);
         if (q->vol[c]) free(q->vol[c] - 1);
         if (q->hcell[c]) free(q->hcell[c] - 1);
     }
@@ -239,11 +236,16 @@ void ibm_free(ibm_t *ibm)
     free(q->hist);
     free(q->runs);
     free(q->alpha);
-    free(q->nb);
-    free(q->nb_start);
-    free(q->start);
+    free(q->nruns_f);
+    free(q->node_asum);
+    free(q->node_target);
+    free(q->node_imp);
+    free(q->line_head);
+    free(q->run_order);
+    free(q->runs_tmp);
     free(q->sum);
     free(q->mom_prev);
+    free(q->target_vel);
     free(q->imp_step);
     free(q);
     free(ibm->s);

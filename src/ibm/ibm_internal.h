@@ -8,19 +8,33 @@
 #include "ibm.h"
 
 /* A run of consecutive nodes of one velocity component inside the band
- * or the interior of one sphere, along the fastest storage direction (z in
+ * or the interior of sphere p, along the fastest storage direction (z in
  * 3-D, y in 2-D): node q = 0..len−1 is at storage index m0 + q·stride, at
  * offset r0 + q·h_run e_run from the sphere's centre (periodic image
- * applied), with solid fraction alpha[a0 + q].  A sphere + band is convex,
- * so a grid line meets it in one segment (two if a periodic face cuts it). */
+ * applied), with solid fraction alpha[a0 + q], and is the forced node
+ * u0 + q of the merged lists below.  A sphere + band is convex, so a grid
+ * line meets it in one segment (two if a periodic face cuts it).  The runs
+ * of all spheres are kept in storage order (by grid line, then m0), so
+ * that every pass over them streams through the velocity field and the α
+ * array instead of jumping from sphere to sphere. */
 typedef struct {
     double r0[3];
     int32_t m0;     /* G_IDX of the first node */
     int32_t a0;     /* index of its α in the alpha array */
+    int32_t u0;     /* index of its first node among the forced nodes */
+    int32_t line;   /* grid line: (component, local x index[, y index]) */
+    int32_t p;      /* sphere */
     int16_t len;
     uint8_t c;      /* velocity component */
-    uint8_t shared; /* another sphere's band may reach a node of the run */
 } ibm_run_t;
+
+/* A run of forced nodes: the union of the spheres' runs on one grid line
+ * that overlap or touch, each node once (node q = 0..len−1 at storage
+ * index m0 + q·stride is forced node n0 + q). */
+typedef struct {
+    int32_t m0, n0, len;
+    uint8_t c;
+} ibm_node_run_t;
 
 typedef struct {
     int n;
@@ -32,27 +46,30 @@ typedef struct {
 enum { IBM_FIMP = 0, IBM_TIMP = 3, IBM_MOM = 6, IBM_ANG = 9, IBM_NSUM = 12 };
 
 typedef struct {
-    /* runs: sphere p owns runs[start[p] .. start[p+1]) */
-    ibm_run_t *runs;
+    /* runs of all spheres in storage order (runs_tmp: as generated) */
+    ibm_run_t *runs, *runs_tmp;
     long nruns, cap_runs;
-    long *start;
     double *alpha;
-    long nalpha, cap_alpha, nshared;
+    long nalpha, cap_alpha, nshared; /* nshared: entries at nodes that another sphere's band reaches */
     int rdir;          /* run direction (2 in 3-D, 1 in 2-D), its stride and spacing */
     long rstride;
     double rstep;
-    /* neighbours of each sphere: the spheres (periodic images included)
-     * whose band may reach its nodes, nb[nb_start[p] .. nb_start[p+1]), each
-     * with the offset of that image's centre from sphere p's */
-    struct ibm_neighbour {
-        int o;
-        double d[3];
-    } *nb;
-    int *nb_start;
-    long nb_cap;
-    /* dense scratch of each component: Σ_p α_p, then Σ_p α_p U_p and the
-     * impulse of the forcing (zero outside the node lists between uses) */
-    double *asum[3], *aux[3];
+    /* the forced nodes (each node once, whatever the number of spheres
+     * whose band reaches it), by runs along the grid lines; per node:
+     * Σ_p α_p, the target velocity Σ_p (α_p/Σα) U_p(r) of the forcing, and
+     * the forcing impulse accumulated since the target was set */
+    ibm_node_run_t *nruns_f;
+    long n_nruns, cap_nruns;
+    double *node_asum, *node_target, *node_imp;
+    long nnodes, cap_nodes;
+    int32_t *line_head;  /* scratch of the sort: first of each grid line's runs in run_order */
+    int32_t *run_order;
+    long cap_next;
+    int built;         /* node lists exist */
+    int imp_fresh;     /* node_imp is to be restarted by the next forcing */
+    int targets_valid; /* node_target was set from these node lists and the velocities in target_vel */
+    double *target_vel; /* n × 6: u, ω of each sphere when node_target was set */
+    int frozen;        /* this step: no sphere moves within it (forcing.c) */
     /* control volume of each unknown by local x index (−1..nxl), times 2π
      * in axisymmetric geometry: the integrals are over the whole volume */
     double *vol[3];
