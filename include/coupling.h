@@ -33,6 +33,24 @@ ibm_sphere_t *coupling_spheres_of_particles(const dem_t *d, int *n);
 /* Step 1 → 2: hand the hydrodynamic force and torque of the last fluid step,
  * with the buoyancy −ρ V_p g, to the DEM as its external force and torque. */
 void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3]);
+/* The fluid frozen during collisions (docs/theory.md §9.1): while a
+ * particle is in contact at the start of a fluid step (for at most
+ * hold_time of contact), the DEM keeps the hydrodynamic force and torque of
+ * the last step before the contact, and the difference is applied, as an
+ * impulse spread over one step, once the contact is over.  Matters only
+ * when the fluid step is shorter than the contact. */
+typedef struct {
+    int n;
+    double hold_time;
+    double *F0;     /* 6n: force and torque of the last step before the contact (by sphere) */
+    double *J;      /* 6n: impulse deferred while frozen */
+    double *held;   /* n: contact time spent frozen */
+} coupling_freeze_t;
+void coupling_freeze_init(coupling_freeze_t *fz, int n, double hold_time);
+void coupling_freeze_free(coupling_freeze_t *fz);
+/* As coupling_forces_to_dem, through the freeze (fz NULL: no freeze). */
+void coupling_forces_to_dem_frozen(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3],
+                                   coupling_freeze_t *fz, double dt);
 /* Step 2 → 3: positions and velocities of the particles to the spheres, and
  * the solid fraction rebuilt (collective). */
 void coupling_motion_to_ibm(const dem_t *d, ibm_t *ibm);

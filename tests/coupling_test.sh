@@ -2,8 +2,11 @@
 # coupling_test.sh — the resolved IBM–DEM coupling (coupling.h) on the bouncing sphere of
 # cases/bouncing_sphere/bounce_axi.ini, coarsened to D/dx = 10 (40 x 440 cells, ~4 s a run):
 #  1. sub-cycling: M = dt_f/dt_s varied 10x (dem.steps_per_contact 50 and 500) changes
-#     eps/eps_max by < 1e-3 and the impact speed at the onset by < 0.5 % (docs/theory.md §9: the
-#     held hydrodynamic force makes the result independent of M once dt_s resolves the contact);
+#     eps/eps_max by < 1e-3 and V_C (the last fluid step before the contact) by < 0.1 %
+#     (docs/theory.md §9: the held hydrodynamic force makes the result independent of M once
+#     dt_s resolves the contact; the speed at the last SUB-step before the contact, V_C_onset,
+#     is not compared: it is taken up to u dt_s from the wall and the lubrication of that last
+#     gap, logarithmic in it, is still to come);
 #  2. restart: a run through the bounce and the same run stopped before it and restarted give
 #     bit-identical particle and fluid states (h5diff --delta=0) and the same restitution results;
 #  3. 1 vs 2 ranks: the same bounce to round-off (eps/eps_max within 1e-9);
@@ -27,12 +30,13 @@ $PY - $T/m50/summary.json $T/m500/summary.json <<'PY'
 import json, sys
 a, b = (json.load(open(p))["coupling"] for p in sys.argv[1:3])
 de = abs(a["epsilon_over_max"] - b["epsilon_over_max"])
-dc = abs(a["V_C_onset"] - b["V_C_onset"]) / a["V_C_onset"]
+dc = abs(a["V_C"] - b["V_C"]) / a["V_C"]
 print(f"# M x10: substeps {a['dem_substeps']} -> {b['dem_substeps']}, eps/eps_max {a['epsilon_over_max']:.6f} -> "
-      f"{b['epsilon_over_max']:.6f} (diff {de:.2e}), V_C onset diff {dc:.2e}, St {a['St']:.3f}")
-sys.exit(0 if de < 1e-3 and dc < 5e-3 and b["dem_substeps"] > 9 * a["dem_substeps"] else 1)
+      f"{b['epsilon_over_max']:.6f} (diff {de:.2e}), V_C diff {dc:.2e}, V_C_onset {a['V_C_onset']:.5f} -> "
+      f"{b['V_C_onset']:.5f}, St {a['St']:.3f}")
+sys.exit(0 if de < 1e-3 and dc < 1e-3 and b["dem_substeps"] > 9 * a["dem_substeps"] else 1)
 PY
-report $? "sub-cycling: eps/eps_max and the impact speed do not change when M varies 10x"
+report $? "sub-cycling: eps/eps_max and V_C do not change when M varies 10x"
 
 # 2. restart through the bounce (contact at step ~1060 at this resolution)
 R="$C --set output.series_every=1"

@@ -29,9 +29,13 @@ static const cfg_key_t coupling_keys[] = {
     {"coupling", "stop_after_rebound", CFG_BOOL, "false", 1, 0, NULL,
      "restitution: stop the run once the bounce is measured (the particle moves towards the wall again, touches "
      "it a second time, rests on it, or stopped before touching it)"},
-    {"coupling", "align_contacts", CFG_BOOL, "false", 1, 0, NULL,
+    {"coupling", "align_contacts", CFG_BOOL, "true", 1, 0, NULL,
      "end a fluid step where a contact is predicted to start (steps not shorter than t_c/4), so that "
      "collisions start at the beginning of a fluid step"},
+    {"coupling", "freeze_collisions", CFG_DOUBLE, "2", 0, 1e6, NULL,
+     "hold a particle's hydrodynamic force at its value before a contact for up to this many contact times "
+     "of contact, the fluid's force meanwhile applied after it (the seed's fluid frozen during collisions; "
+     "matters when the fluid step is shorter than t_c); 0: off"},
     {"coupling", "restitution_axis", CFG_VEC3, NULL, -1e300, 1e300, NULL,
      "wall: direction from the particle towards the wall (default: along gravity)"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
@@ -52,6 +56,8 @@ typedef struct {
     dem_status_t status;
     int stop_after;      /* [coupling] stop_after_rebound */
     int align;           /* [coupling] align_contacts */
+    double freeze;       /* [coupling] freeze_collisions (contact times) */
+    coupling_freeze_t fz;
     double wall_dem;     /* wall time in the DEM */
     long substeps;       /* DEM sub-steps done */
 } coupling_part_t;
@@ -86,6 +92,7 @@ static void setup(coupling_part_t *cp)
     cp->d = sim_dem_engine(cp->sim);
     tracked_particle(cp);
     dem_get_gravity(cp->d, cp->gravity);
+    if (cp->fz.n) cp->fz.hold_time = cp->freeze * dem_contact_time(cp->d);
     if (cp->rest.mode != RESTITUTION_OFF) dem_set_step_observer(cp->d, observe, cp);
     if (cp->ibm) {
         if (dem_count(cp->d) != cp->ibm->n) die("coupling: %d particles but %d immersed spheres", dem_count(cp->d), cp->ibm->n);
@@ -115,7 +122,7 @@ static void part_advance(void *ctx, double dt)
     cp->rest.lub_impulse = 0;
     if (cp->ibm) {
         const double w0 = wtime();
-        coupling_forces_to_dem(cp->ibm, cp->d, cp->rho_f, cp->gravity);
+        coupling_forces_to_dem_frozen(cp->ibm, cp->d, cp->rho_f, cp->gravity, cp->fz.n ? &cp->fz : NULL, dt);
         cp->status = dem_advance(cp->d, dem_time(cp->d) + dt);
         cp->wall_dem += wtime() - w0;
         if (cp->status == DEM_OK) coupling_motion_to_ibm(cp->d, cp->ibm);
@@ -154,6 +161,11 @@ static void part_checkpoint_write(void *ctx, hid_t grp)
     double v[REST_NSTATE];
     pack(&cp->rest, v);
     io_h5_write_array(grp, "restitution", REST_NSTATE, v);
+    if (cp->fz.n) {
+        io_h5_write_array(grp, "freeze_force", 6L * cp->fz.n, cp->fz.F0);
+        io_h5_write_array(grp, "freeze_impulse", 6L * cp->fz.n, cp->fz.J);
+        io_h5_write_array(grp, "freeze_held", cp->fz.n, cp->fz.held);
+    }
 }
 
 static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
@@ -166,10 +178,18 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
     r->phase = (int)v[0];
     r->u_last = v[1], r->VT = v[2], r->VC = v[3], r->VR = v[4], r->VR_release = v[5];
     r->t_contact = v[6], r->t_release = v[7], r->lub_impulse = v[8], r->VC_onset = v[9];
+    if (cp->fz.n) {
+        const long n = cp->fz.n;
+        if (io_h5_read_array(grp, "freeze_force", 6 * n, cp->fz.F0) != 6 * n ||
+            io_h5_read_array(grp, "freeze_impulse", 6 * n, cp->fz.J) != 6 * n ||
+            io_h5_read_array(grp, "freeze_held", n, cp->fz.held) != n)
+            die("%s: /coupling/freeze_* is missing or has the wrong size", path);
+    }
     cp->synced = 1; /* the spheres and particles come from the checkpoint */
     cp->d = sim_dem_engine(cp->sim);
     tracked_particle(cp);
     dem_get_gravity(cp->d, cp->gravity);
+    if (cp->fz.n) cp->fz.hold_time = cp->freeze * dem_contact_time(cp->d);
     if (cp->rest.mode != RESTITUTION_OFF) dem_set_step_observer(cp->d, observe, cp);
     if (cp->ibm) memcpy(cp->ibm->prm.gravity, cp->gravity, sizeof cp->gravity);
 }
@@ -228,7 +248,12 @@ static int part_done(void *ctx)
     }
 }
 
-static void part_destroy(void *ctx) { free(ctx); }
+static void part_destroy(void *ctx)
+{
+    coupling_part_t *cp = ctx;
+    coupling_freeze_free(&cp->fz);
+    free(cp);
+}
 
 void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
 {
@@ -253,6 +278,8 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
     /* density, diameter and ε_max of the tracked particle: at setup */
     restitution_init(&cp->rest, (restitution_mode_t)mode, axis, cp->rho_f, mu, 0.0, 0.0, 0.0);
     cp->align = cfg_bool(cfg, "coupling", "align_contacts");
+    cp->freeze = cfg_double(cfg, "coupling", "freeze_collisions");
+    if (ibm && cp->freeze > 0 && ibm->n > 0) coupling_freeze_init(&cp->fz, ibm->n, 0.0); /* hold time at setup */
     cp->stop_after = mode != RESTITUTION_OFF && cfg_bool(cfg, "coupling", "stop_after_rebound");
     sim_part_t part = {
         .name = "coupling",

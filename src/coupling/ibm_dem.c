@@ -31,21 +31,65 @@ ibm_sphere_t *coupling_spheres_of_particles(const dem_t *d, int *n)
     return s;
 }
 
-void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3])
+void coupling_freeze_init(coupling_freeze_t *fz, int n, double hold_time)
+{
+    fz->n = n;
+    fz->hold_time = hold_time;
+    fz->F0 = xcalloc(6 * (size_t)(n > 0 ? n : 1), sizeof(double));
+    fz->J = xcalloc(6 * (size_t)(n > 0 ? n : 1), sizeof(double));
+    fz->held = xcalloc((size_t)(n > 0 ? n : 1), sizeof(double));
+}
+
+void coupling_freeze_free(coupling_freeze_t *fz)
+{
+    free(fz->F0);
+    free(fz->J);
+    free(fz->held);
+    memset(fz, 0, sizeof *fz);
+}
+
+void coupling_forces_to_dem_frozen(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3],
+                                   coupling_freeze_t *fz, double dt)
 {
     double *fe = dem_ext_force(d), *te = dem_ext_torque(d);
-    const double *r = dem_radii(d);
+    const double *r = dem_radii(d), *fc = dem_contact_forces(d);
     const long *id = dem_ids(d);
     for (int i = 0; i < dem_count(d); i++) {
-        const ibm_sphere_t *s = &ibm->s[id[i]];
+        const long p = id[i];
+        const ibm_sphere_t *s = &ibm->s[p];
         const double V = 4.0 / 3.0 * M_PI * r[i] * r[i] * r[i];
+        double F[6] = {s->force[0], s->force[1], s->force[2], s->torque[0], s->torque[1], s->torque[2]};
+        if (fz) {
+            const int contact = fc[3 * i] != 0 || fc[3 * i + 1] != 0 || fc[3 * i + 2] != 0;
+            double *F0 = fz->F0 + 6 * p, *J = fz->J + 6 * p;
+            if (contact && fz->held[p] < fz->hold_time) {
+                /* frozen: the force before the contact; what the fluid did meanwhile is deferred */
+                for (int a = 0; a < 6; a++) {
+                    J[a] += (F[a] - F0[a]) * dt;
+                    F[a] = F0[a];
+                }
+                fz->held[p] += dt;
+            } else {
+                for (int a = 0; a < 6; a++) {
+                    if (!contact) F0[a] = F[a];
+                    F[a] += J[a] / dt;
+                    J[a] = 0.0;
+                }
+                if (!contact) fz->held[p] = 0.0;
+            }
+        }
         for (int a = 0; a < 3; a++) {
             /* decision 7: the fluid pressure is relative to hydrostatic, so the DEM's weight m_p g
              * needs the buoyancy −ρ V_p g besides the hydrodynamic force of the immersed boundary */
-            fe[3 * i + a] = s->force[a] - rho_fluid * V * gravity[a];
-            te[3 * i + a] = s->torque[a];
+            fe[3 * i + a] = F[a] - rho_fluid * V * gravity[a];
+            te[3 * i + a] = F[3 + a];
         }
     }
+}
+
+void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3])
+{
+    coupling_forces_to_dem_frozen(ibm, d, rho_fluid, gravity, NULL, 1.0);
 }
 
 void coupling_motion_to_ibm(const dem_t *d, ibm_t *ibm)

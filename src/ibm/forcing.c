@@ -274,7 +274,7 @@ static int step_frozen(const ibm_t *ibm)
  * (prescribed) counts in its force; the rest (e.g. a collision resolved by
  * the DEM within the step) is not counted, as when α is rebuilt at the new
  * centre.  Along the move, I^0 = I_old + (1 − λ)(I_new − I_old) with
- * λ = δ_p·δ/|δ|² (λ = 1: the whole change is counted, the impulses
+ * λ = δ_p·δ/|δ|² clamped to [0, 1] (λ = 1: the whole change is counted, the impulses
  * telescope over the steps; λ = 0: I^0 = I_new), L likewise about the new
  * centre (L_old − δ × I_old).  Returns whether any sphere moved (then the
  * node lists are rebuilt here). */
@@ -291,7 +291,10 @@ static int carry_external_moves(ibm_t *ibm)
         displacement(ibm->g, s->xa, s->x, dx);
         displacement(ibm->g, s->xa, s->xpred, dp);
         for (int d = 0; d < 3; d++) dd += dx[d] * dx[d], dpd += dp[d] * dx[d];
+        /* clamped to [0, 1]: a move shorter than the predicted one (a sphere stopped by a
+         * collision: δ ≪ δ_p) would otherwise extrapolate I^0 beyond I_old and I_new */
         lam[p] = dd > 0 ? dpd / dd : 0.0;
+        lam[p] = lam[p] < 0 ? 0.0 : lam[p] > 1 ? 1.0 : lam[p];
         L[0] -= dx[1] * I[2] - dx[2] * I[1];
         L[1] -= dx[2] * I[0] - dx[0] * I[2];
         L[2] -= dx[0] * I[1] - dx[1] * I[0];
