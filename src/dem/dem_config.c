@@ -359,7 +359,7 @@ void dem_config_particles(dem_t *d, cfg_t *cfg)
     } else if (source == 4) {
         int count = 0;
         for (int k = 1; k <= 9; k++) {
-            char key[16];
+            char key[24];
             snprintf(key, sizeof key, "particle%d", k);
             if (!cfg_has(cfg, "particles", key)) continue;
             config_list_particle(d, cfg, key);
