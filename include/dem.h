@@ -105,15 +105,10 @@ double *dem_ext_torque(dem_t *d);
 /* Total contact force of each particle (pairs and walls) at the last step. */
 const double *dem_contact_forces(const dem_t *d);
 
-/* Brenner lubrication (lubrication.c; [lubrication] in a case file):
- * viscosity η_f (≤ 0: off), η_e/R, Δ_lub/R, subtract the force at Δ_lub,
- * also against walls.  Call before the first step. */
-void dem_set_lubrication(dem_t *d, double viscosity, double roughness, double range, int subtract, int walls);
+/* Brenner lubrication (lubrication.c), set by [lubrication] in a case file. */
 void dem_lubrication_register_keys(void);
-/* Lubrication force on each particle in the last step (impulse / dt), 3n;
- * pairs and walls that exchanged a lubrication impulse in the last step. */
+/* Lubrication force on each particle in the last step (impulse / dt), 3n. */
 const double *dem_lubrication_forces(const dem_t *d);
-long dem_lubrication_active(const dem_t *d);
 /* Time until the first particle–particle or particle–wall contact at the
  * current velocities (0: a contact exists; INFINITY: nothing approaches). */
 double dem_time_to_contact(const dem_t *d);

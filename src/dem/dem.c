@@ -646,20 +646,14 @@ double dem_time_to_contact(const dem_t *d)
     /* pairs from the neighbour lists (every pair that can touch before the next rebuild),
      * walls directly; the relative velocity is held */
     double tmin = INFINITY;
-    const double *x = d->x, *v = d->v, *r = d->r;
     if (d->nb_start)
         for (int i = 0; i < d->nb_n_rows; i++)
             for (long e = d->nb_start[i]; e < d->nb_start[i + 1]; e++) {
                 const int j = d->nb_j[e];
-                const double *sh = d->any_periodic ? d->shift[d->nb_img[e]] : d->shift[13];
-                double n[3], dist2 = 0, u = 0;
-                for (int a = 0; a < 3; a++) {
-                    n[a] = x[3 * j + a] + sh[a] - x[3 * i + a];
-                    dist2 += n[a] * n[a];
-                }
-                const double dist = sqrt(dist2), gap = dist - r[i] - r[j];
+                double n[3];
+                const double gap = dem_pair_normal(d, i, e, n) - d->r[i] - d->r[j];
                 if (gap <= 0) return 0.0;
-                for (int a = 0; a < 3; a++) u += (v[3 * i + a] - v[3 * j + a]) * n[a] / dist;
+                const double u = dem_pair_approach(d, i, j, n);
                 if (u > 0 && gap / u < tmin) tmin = gap / u;
             }
     for (int w = 0; w < d->nwall; w++) {
@@ -667,12 +661,8 @@ double dem_time_to_contact(const dem_t *d)
         if (!W->active) continue;
         for (int i = 0; i < d->n; i++) {
             if (d->fixed[i]) continue;
-            double s = 0, u = 0;
-            for (int a = 0; a < 3; a++) {
-                s += (x[3 * i + a] - W->p[a]) * W->n[a];
-                u -= (v[3 * i + a] - W->vel[a]) * W->n[a];
-            }
-            const double gap = s - r[i];
+            double u;
+            const double gap = dem_wall_gap(d, W, i, &u);
             if (gap <= 0) return 0.0;
             if (u > 0 && gap / u < tmin) tmin = gap / u;
         }

@@ -45,7 +45,6 @@ typedef struct {
     double roughness;    /* η_e / R */
     double range;        /* Δ_lub / R */
     double reach;        /* largest Δ_lub among the particles (m): margin of the lists */
-    long active;         /* pairs and walls that exchanged a lubrication impulse in the last step */
 } dem_lub_t;
 
 /* Called after every DEM step (dem_set_step_observer). */
@@ -222,6 +221,42 @@ void dem_lubrication_config(dem_t *d, cfg_t *cfg);
 /* Apply the lubrication impulses of the coming drift of length dt to the
  * half-step velocities (implicit in the gap, see lubrication.c). */
 void dem_lubrication_impulses(dem_t *d, double dt);
+
+/* ---- pair and wall geometry for the passes outside the force kernel ---- */
+/* Unit normal n from particle i to the partner of its list entry e (the
+ * periodic image included); returns the distance of the centres. */
+static inline double dem_pair_normal(const dem_t *d, int i, long e, double n[3])
+{
+    const int j = d->nb_j[e];
+    const double *sh = d->any_periodic ? d->shift[d->nb_img[e]] : d->shift[13];
+    double dist2 = 0;
+    for (int a = 0; a < 3; a++) {
+        n[a] = d->x[3 * j + a] + sh[a] - d->x[3 * i + a];
+        dist2 += n[a] * n[a];
+    }
+    const double dist = sqrt(dist2);
+    for (int a = 0; a < 3; a++) n[a] /= dist;
+    return dist;
+}
+
+/* Approach speed (v_i − v_j)·n of particles i and j along the unit normal n from i to j. */
+static inline double dem_pair_approach(const dem_t *d, int i, int j, const double n[3])
+{
+    const double *v = d->v;
+    return (v[3 * i] - v[3 * j]) * n[0] + (v[3 * i + 1] - v[3 * j + 1]) * n[1] + (v[3 * i + 2] - v[3 * j + 2]) * n[2];
+}
+
+/* Gap between particle i and wall W, and (*u) its approach speed towards the wall. */
+static inline double dem_wall_gap(const dem_t *d, const dem_wall_t *W, int i, double *u)
+{
+    double s = 0, a_ = 0;
+    for (int a = 0; a < 3; a++) {
+        s += (d->x[3 * i + a] - W->p[a]) * W->n[a];
+        a_ -= (d->v[3 * i + a] - W->vel[a]) * W->n[a];
+    }
+    *u = a_;
+    return s - d->r[i];
+}
 
 /* Small deterministic random generator (splitmix64 / xoshiro256**). */
 typedef struct {

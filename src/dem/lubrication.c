@@ -91,42 +91,30 @@ static inline void lub_params(const dem_lub_t *L, double R, lub_pair_t *p)
 void dem_lubrication_impulses(dem_t *d, double dt)
 {
     const dem_lub_t *L = &d->lub;
-    double *restrict x = d->x, *restrict v = d->v, *restrict fl = d->flub;
+    double *restrict v = d->v, *restrict fl = d->flub;
     const double *restrict r = d->r, *restrict invm = d->invm;
     memset(fl, 0, 3 * (size_t)d->n * sizeof(double));
-    long active = 0;
     const double k0 = 6.0 * M_PI * L->viscosity;
     /* particle pairs, in list order */
     for (int i = 0; i < d->nb_n_rows; i++) {
         for (long e = d->nb_start[i]; e < d->nb_start[i + 1]; e++) {
             const int j = d->nb_j[e];
             if (invm[i] == 0 && invm[j] == 0) continue;
-            const double *sh = d->any_periodic ? d->shift[d->nb_img[e]] : d->shift[13];
-            double n[3], dist2 = 0;
-            for (int a = 0; a < 3; a++) {
-                n[a] = x[3 * j + a] + sh[a] - x[3 * i + a];
-                dist2 += n[a] * n[a];
-            }
-            const double dist = sqrt(dist2), ri = r[i], rj = r[j];
-            const double gap0 = dist - ri - rj, R = ri < rj ? ri : rj;
+            double n[3];
+            const double ri = r[i], rj = r[j], gap0 = dem_pair_normal(d, i, e, n) - ri - rj;
             lub_pair_t p;
-            lub_params(L, R, &p);
-            for (int a = 0; a < 3; a++) n[a] /= dist;
-            const double u = (v[3 * i] - v[3 * j]) * n[0] + (v[3 * i + 1] - v[3 * j + 1]) * n[1] +
-                             (v[3 * i + 2] - v[3 * j + 2]) * n[2];
-            const double gap1 = gap0 - dt * u;
+            lub_params(L, ri < rj ? ri : rj, &p);
+            const double u = dem_pair_approach(d, i, j, n), gap1 = gap0 - dt * u;
             if ((gap0 >= p.range && gap1 >= p.range) || (gap0 <= 0 && gap1 <= 0)) continue;
             const double m = 1.0 / (invm[i] + invm[j]), reff = ri * rj / (ri + rj);
-            const double k = k0 * reff * reff;
-            const double du = lub_solve(&p, m, k, dt, gap0, u) - u; /* change of the approach speed */
-            const double J = m * du;                                 /* impulse along n on i */
+            const double du = lub_solve(&p, m, k0 * reff * reff, dt, gap0, u) - u; /* change of the approach speed */
+            const double J = m * du;                                                /* impulse along n on i */
             for (int a = 0; a < 3; a++) {
                 v[3 * i + a] += J * invm[i] * n[a];
                 v[3 * j + a] -= J * invm[j] * n[a];
                 fl[3 * i + a] += J / dt * n[a];
                 fl[3 * j + a] -= J / dt * n[a];
             }
-            active++;
         }
     }
     /* walls: R_eff → R_i, the wall moves with its velocity and has infinite mass */
@@ -137,26 +125,20 @@ void dem_lubrication_impulses(dem_t *d, double dt)
             for (int q = 0; q < W->nlist; q++) {
                 const int i = W->idx[q];
                 if (invm[i] == 0) continue;
-                double s = 0;
-                for (int a = 0; a < 3; a++) s += (x[3 * i + a] - W->p[a]) * W->n[a];
-                const double gap0 = s - r[i];
+                double u;
+                const double gap0 = dem_wall_gap(d, W, i, &u), gap1 = gap0 - dt * u;
                 lub_pair_t p;
                 lub_params(L, r[i], &p);
-                double u = 0; /* approach speed: towards the wall = against n */
-                for (int a = 0; a < 3; a++) u -= (v[3 * i + a] - W->vel[a]) * W->n[a];
-                const double gap1 = gap0 - dt * u;
                 if ((gap0 >= p.range && gap1 >= p.range) || (gap0 <= 0 && gap1 <= 0)) continue;
-                const double m = 1.0 / invm[i], k = k0 * r[i] * r[i];
-                const double du = lub_solve(&p, m, k, dt, gap0, u) - u;
+                const double m = 1.0 / invm[i];
+                const double du = lub_solve(&p, m, k0 * r[i] * r[i], dt, gap0, u) - u;
                 /* the approach speed changes by du: v changes by −du n */
                 for (int a = 0; a < 3; a++) {
                     v[3 * i + a] -= du * W->n[a];
                     fl[3 * i + a] -= m * du / dt * W->n[a];
                 }
-                active++;
             }
         }
-    d->lub.active = active;
 }
 
 static const cfg_key_t lub_keys[] = {
@@ -194,17 +176,4 @@ void dem_lubrication_config(dem_t *d, cfg_t *cfg)
     if (!(L->viscosity > 0)) cfg_fail(cfg, "lubrication", "viscosity", "must be positive with model = brenner");
 }
 
-void dem_set_lubrication(dem_t *d, double viscosity, double roughness, double range, int subtract, int walls)
-{
-    dem_lub_t *L = &d->lub;
-    L->on = viscosity > 0;
-    L->viscosity = viscosity;
-    L->roughness = roughness;
-    L->range = range;
-    L->subtract = subtract;
-    L->walls = walls;
-    d->ready = 0; /* the list margin changes */
-}
-
 const double *dem_lubrication_forces(const dem_t *d) { return d->flub; }
-long dem_lubrication_active(const dem_t *d) { return d->lub.active; }
