@@ -30,9 +30,6 @@
  * the particles' ids (sphere p is the particle of id p).  *n gets the count;
  * the array is malloc'd. */
 ibm_sphere_t *coupling_spheres_of_particles(const dem_t *d, int *n);
-/* Step 1 → 2: hand the hydrodynamic force and torque of the last fluid step,
- * with the buoyancy −ρ V_p g, to the DEM as its external force and torque. */
-void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3]);
 /* The fluid frozen during collisions (docs/theory.md §9.1): while a
  * particle is in contact at the start of a fluid step (for at most
  * hold_time of contact), the DEM keeps the hydrodynamic force and torque of
@@ -48,9 +45,11 @@ typedef struct {
 } coupling_freeze_t;
 void coupling_freeze_init(coupling_freeze_t *fz, int n, double hold_time);
 void coupling_freeze_free(coupling_freeze_t *fz);
-/* As coupling_forces_to_dem, through the freeze (fz NULL: no freeze). */
-void coupling_forces_to_dem_frozen(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3],
-                                   coupling_freeze_t *fz, double dt);
+/* Step 1 → 2: hand the hydrodynamic force and torque of the last fluid step
+ * (of length dt), with the buoyancy −ρ V_p g, to the DEM as its external
+ * force and torque, through the freeze fz (NULL: none). */
+void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3],
+                            coupling_freeze_t *fz, double dt);
 /* Step 2 → 3: positions and velocities of the particles to the spheres, and
  * the solid fraction rebuilt (collective). */
 void coupling_motion_to_ibm(const dem_t *d, ibm_t *ibm);
@@ -82,7 +81,7 @@ void restitution_init(restitution_t *r, restitution_mode_t mode, const double ax
 /* After every DEM sub-step (an observer, dem_set_step_observer). */
 void restitution_substep(restitution_t *r, dem_t *d);
 /* After every fluid step (or driver step of a dry run). */
-void restitution_sample(restitution_t *r, dem_t *d, double time);
+void restitution_sample(restitution_t *r, dem_t *d);
 /* Approach speed of the tracked motion now (wall: v·axis; pair: (v₀ − v₁)·n₀₁). */
 double restitution_approach_speed(const restitution_t *r, dem_t *d, int full_step);
 /* Results: ε = V_R/V_T, St = (ρ_p + ρ/2) V_T D/(9μ) and Re_p = ρ V_T D/μ

@@ -84,20 +84,28 @@ static void tracked_particle(coupling_part_t *cp)
     cp->rest.e_dry = dem_dry_restitution(cp->d);
 }
 
-/* The DEM engine, prepared, and the spheres at its particles (once). */
-static void setup(coupling_part_t *cp)
+/* The DEM engine (prepared), the tracked particle, gravity, the freeze's
+ * hold time and the sub-step observer: at the first use, or after a restart. */
+static void attach(coupling_part_t *cp)
 {
-    if (cp->synced) return;
-    cp->synced = 1;
     cp->d = sim_dem_engine(cp->sim);
     tracked_particle(cp);
     dem_get_gravity(cp->d, cp->gravity);
     if (cp->fz.n) cp->fz.hold_time = cp->freeze * dem_contact_time(cp->d);
     if (cp->rest.mode != RESTITUTION_OFF) dem_set_step_observer(cp->d, observe, cp);
+    if (cp->ibm) memcpy(cp->ibm->prm.gravity, cp->gravity, sizeof cp->gravity);
+}
+
+/* Once, before the first step of a new run: attach, and the spheres at the
+ * particles (they may have moved in the packing preparation). */
+static void setup(coupling_part_t *cp)
+{
+    if (cp->synced) return;
+    cp->synced = 1;
+    attach(cp);
     if (cp->ibm) {
         if (dem_count(cp->d) != cp->ibm->n) die("coupling: %d particles but %d immersed spheres", dem_count(cp->d), cp->ibm->n);
-        memcpy(cp->ibm->prm.gravity, cp->gravity, sizeof cp->gravity);
-        if (cp->sim->step == 0) coupling_motion_to_ibm(cp->d, cp->ibm); /* after the packing preparation */
+        if (cp->sim->step == 0) coupling_motion_to_ibm(cp->d, cp->ibm);
     }
 }
 
@@ -119,15 +127,14 @@ static void part_advance(void *ctx, double dt)
 {
     coupling_part_t *cp = ctx;
     setup(cp);
-    cp->rest.lub_impulse = 0;
     if (cp->ibm) {
         const double w0 = wtime();
-        coupling_forces_to_dem_frozen(cp->ibm, cp->d, cp->rho_f, cp->gravity, cp->fz.n ? &cp->fz : NULL, dt);
+        coupling_forces_to_dem(cp->ibm, cp->d, cp->rho_f, cp->gravity, cp->fz.n ? &cp->fz : NULL, dt);
         cp->status = dem_advance(cp->d, dem_time(cp->d) + dt);
         cp->wall_dem += wtime() - w0;
         if (cp->status == DEM_OK) coupling_motion_to_ibm(cp->d, cp->ibm);
     }
-    restitution_sample(&cp->rest, cp->d, cp->sim->time + dt);
+    restitution_sample(&cp->rest, cp->d);
 }
 
 static void part_diagnostics(void *ctx, double *c)
@@ -135,7 +142,10 @@ static void part_diagnostics(void *ctx, double *c)
     coupling_part_t *cp = ctx;
     setup(cp);
     c[0] = restitution_approach_speed(&cp->rest, cp->d, 0);
+    /* the impulse the observer summed over the sub-steps of the step (in a dry run the DEM
+     * part advances before this part), reported once and reset */
     c[1] = cp->sim->dt > 0 ? cp->rest.lub_impulse / cp->sim->dt : 0.0;
+    cp->rest.lub_impulse = 0;
 }
 
 static int part_diverged(void *ctx, char *why, size_t n)
@@ -186,12 +196,7 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
             die("%s: /coupling/freeze_* is missing or has the wrong size", path);
     }
     cp->synced = 1; /* the spheres and particles come from the checkpoint */
-    cp->d = sim_dem_engine(cp->sim);
-    tracked_particle(cp);
-    dem_get_gravity(cp->d, cp->gravity);
-    if (cp->fz.n) cp->fz.hold_time = cp->freeze * dem_contact_time(cp->d);
-    if (cp->rest.mode != RESTITUTION_OFF) dem_set_step_observer(cp->d, observe, cp);
-    if (cp->ibm) memcpy(cp->ibm->prm.gravity, cp->gravity, sizeof cp->gravity);
+    attach(cp);
 }
 
 static void part_summary(void *ctx, io_summary_t *y, const char *prefix)

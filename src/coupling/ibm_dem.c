@@ -48,8 +48,8 @@ void coupling_freeze_free(coupling_freeze_t *fz)
     memset(fz, 0, sizeof *fz);
 }
 
-void coupling_forces_to_dem_frozen(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3],
-                                   coupling_freeze_t *fz, double dt)
+void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3],
+                            coupling_freeze_t *fz, double dt)
 {
     double *fe = dem_ext_force(d), *te = dem_ext_torque(d);
     const double *r = dem_radii(d), *fc = dem_contact_forces(d);
@@ -87,10 +87,6 @@ void coupling_forces_to_dem_frozen(const ibm_t *ibm, dem_t *d, double rho_fluid,
     }
 }
 
-void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3])
-{
-    coupling_forces_to_dem_frozen(ibm, d, rho_fluid, gravity, NULL, 1.0);
-}
 
 void coupling_motion_to_ibm(const dem_t *d, ibm_t *ibm)
 {

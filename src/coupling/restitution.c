@@ -52,67 +52,69 @@ static int index_of(const dem_t *d, long id)
     return -1;
 }
 
-double restitution_approach_speed(const restitution_t *r, dem_t *d, int full_step)
+/* Velocity of particle i, full-step or as stored. */
+static void velocity_of(dem_t *d, int i, int full_step, double v[3])
 {
-    const int i = index_of(d, 0);
-    if (i < 0) return 0.0;
-    double vi[3];
     if (full_step)
-        dem_full_velocity(d, i, vi);
+        dem_full_velocity(d, i, v);
     else
-        memcpy(vi, dem_velocities(d) + 3 * i, sizeof vi);
-    if (r->mode == RESTITUTION_WALL) return vi[0] * r->axis[0] + vi[1] * r->axis[1] + vi[2] * r->axis[2];
-    const int j = index_of(d, 1);
-    if (j < 0) return 0.0;
-    double vj[3], n[3], len = 0;
-    if (full_step)
-        dem_full_velocity(d, j, vj);
-    else
-        memcpy(vj, dem_velocities(d) + 3 * j, sizeof vj);
-    const double *x = dem_positions(d);
-    for (int a = 0; a < 3; a++) {
-        n[a] = x[3 * j + a] - x[3 * i + a];
-        len += n[a] * n[a];
-    }
-    len = sqrt(len);
-    double u = 0;
-    for (int a = 0; a < 3; a++) u += (vi[a] - vj[a]) * n[a] / len;
-    return u;
+        memcpy(v, dem_velocities(d) + 3 * i, 3 * sizeof(double));
 }
 
-static int in_contact(const restitution_t *r, dem_t *d)
+/* Direction of the approach: the wall axis, or the unit vector from particle i to j. */
+static void approach_direction(const restitution_t *r, dem_t *d, int i, int j, double dir[3])
 {
-    (void)r;
-    const int i = index_of(d, 0);
-    if (i < 0) return 0;
-    const double *f = dem_contact_forces(d) + 3 * i;
-    return f[0] != 0 || f[1] != 0 || f[2] != 0;
+    memcpy(dir, r->axis, 3 * sizeof(double));
+    if (r->mode != RESTITUTION_PAIR || j < 0) return;
+    const double *x = dem_positions(d);
+    double len = 0;
+    for (int a = 0; a < 3; a++) {
+        dir[a] = x[3 * j + a] - x[3 * i + a];
+        len += dir[a] * dir[a];
+    }
+    len = sqrt(len);
+    for (int a = 0; a < 3; a++) dir[a] /= len;
+}
+
+/* Approach speed of particle i (wall), or of i towards j (pair), along dir. */
+static double approach_speed(const restitution_t *r, dem_t *d, int i, int j, const double dir[3], int full_step)
+{
+    double vi[3], vj[3] = {0, 0, 0};
+    velocity_of(d, i, full_step, vi);
+    if (r->mode == RESTITUTION_PAIR) velocity_of(d, j, full_step, vj);
+    return (vi[0] - vj[0]) * dir[0] + (vi[1] - vj[1]) * dir[1] + (vi[2] - vj[2]) * dir[2];
+}
+
+/* The tracked particles: i = id 0, j = id 1 (pair); 0 if they are not there. */
+static int tracked(const restitution_t *r, dem_t *d, int *i, int *j)
+{
+    *i = index_of(d, 0);
+    *j = r->mode == RESTITUTION_PAIR ? index_of(d, 1) : -1;
+    return *i >= 0 && (r->mode != RESTITUTION_PAIR || *j >= 0);
+}
+
+double restitution_approach_speed(const restitution_t *r, dem_t *d, int full_step)
+{
+    int i, j;
+    if (!tracked(r, d, &i, &j)) return 0.0;
+    double dir[3];
+    approach_direction(r, d, i, j, dir);
+    return approach_speed(r, d, i, j, dir, full_step);
 }
 
 void restitution_substep(restitution_t *r, dem_t *d)
 {
-    if (r->mode == RESTITUTION_OFF) return;
-    const double u = restitution_approach_speed(r, d, 1);
-    const int c = in_contact(r, d);
-    const int i = index_of(d, 0);
-    if (i >= 0) {
-        /* impulse on particle 0 against its approach direction (the wall axis, or the line
-         * from particle 0 to particle 1): positive when it pushes the particle back */
-        double dir[3] = {r->axis[0], r->axis[1], r->axis[2]};
-        const int j = r->mode == RESTITUTION_PAIR ? index_of(d, 1) : -1;
-        if (j >= 0) {
-            const double *x = dem_positions(d);
-            double len = 0;
-            for (int a = 0; a < 3; a++) {
-                dir[a] = x[3 * j + a] - x[3 * i + a];
-                len += dir[a] * dir[a];
-            }
-            len = sqrt(len);
-            for (int a = 0; a < 3; a++) dir[a] /= len;
-        }
-        const double *fl = dem_lubrication_forces(d) + 3 * i;
-        r->lub_impulse -= dem_dt(d) * (fl[0] * dir[0] + fl[1] * dir[1] + fl[2] * dir[2]);
-    }
+    int i, j;
+    if (r->mode == RESTITUTION_OFF || !tracked(r, d, &i, &j)) return;
+    double dir[3];
+    approach_direction(r, d, i, j, dir);
+    const double u = approach_speed(r, d, i, j, dir, 1);
+    /* a contact is on while particle 0 carries a contact force (clipped normal force) */
+    const double *fc = dem_contact_forces(d) + 3 * i, *fl = dem_lubrication_forces(d) + 3 * i;
+    const int c = fc[0] != 0 || fc[1] != 0 || fc[2] != 0;
+    /* lubrication impulse on particle 0 against its approach direction: positive when it
+     * pushes the particle back */
+    r->lub_impulse -= dem_dt(d) * (fl[0] * dir[0] + fl[1] * dir[1] + fl[2] * dir[2]);
     switch (r->phase) {
     case 0:
         if (c) {
@@ -136,9 +138,8 @@ void restitution_substep(restitution_t *r, dem_t *d)
     r->u_last = u;
 }
 
-void restitution_sample(restitution_t *r, dem_t *d, double time)
+void restitution_sample(restitution_t *r, dem_t *d)
 {
-    (void)time;
     if (r->mode == RESTITUTION_OFF) return;
     const double u = restitution_approach_speed(r, d, 0);
     if (r->phase == 0 && u > r->VT) r->VT = u;
