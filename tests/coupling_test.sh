@@ -91,7 +91,7 @@ roughness = 1e-3
 range = 0.5
 viscosity = 0.01
 [dem]
-gravity = 0 0 -1e-30
+gravity = 0 0 0
 substeps = 10
 [coupling]
 fluid = off
