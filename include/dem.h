@@ -131,6 +131,15 @@ int dem_wall_count(const dem_t *d);
 void dem_wall_force(const dem_t *d, int w, double f[3]);
 int dem_wall_active(const dem_t *d, int w);
 const char *dem_wall_name(const dem_t *d, int w);
+/* Index of the wall with this name (x_lo ... z_hi, wall1 ...), -1: none. */
+int dem_wall_find(const dem_t *d, const char *name);
+/* A point of wall w (it moves with the wall). */
+void dem_wall_position(const dem_t *d, int w, double p[3]);
+/* Make wall w a piston: pushed along its normal (towards the particles) by
+ * the force `push` (N) and moved by Newton's law with its mass (kg) and the
+ * particles' force ([walls] wall<N>_force / wall<N>_mass); mass 0: back to
+ * its prescribed velocity. */
+void dem_wall_set_load(dem_t *d, int w, double push, double mass);
 
 /* Diagnostics (collective).  dem_diag_light skips the elastic energy (a pass
  * over the contacts). */

@@ -271,6 +271,12 @@ void dem_compute_forces(dem_t *d)
 
 /* ---- integration ---- */
 
+/* F − α|F| sgn(v) (local non-viscous damping, sgn(0) = 0) */
+static inline double local_damping(double F, double v, double alpha)
+{
+    return v > 0 ? F - alpha * fabs(F) : v < 0 ? F + alpha * fabs(F) : F;
+}
+
 /* Opening kick and drift (with the pending closing kick of the previous
  * step fused in); returns max |v|² over the mobile particles. */
 static double kick_drift(dem_t *d)
@@ -283,7 +289,35 @@ static double kick_drift(dem_t *d)
     const unsigned char *restrict fixed = d->fixed;
     const int n = d->n;
     double vmax2 = 0.0;
-    if (d->use_ext) {
+    if (d->damping > 0) {
+        /* local non-viscous damping (Cundall & Strack 1979; Yade's
+         * NewtonIntegrator): each component of the resultant force (gravity
+         * and external forces included) and torque becomes F − α|F| sgn(v),
+         * v the half-step velocity.  It removes a fraction of the kinetic
+         * energy of every oscillation (amplitude ratio √((1−α)/(1+α)) per
+         * half-cycle of a linear oscillator) and vanishes at equilibrium, so
+         * it changes neither the static state nor a quasi-static path. */
+        const double alpha = d->damping;
+        const double *fe = d->use_ext ? d->fext : NULL, *te = d->use_ext ? d->text : NULL;
+        for (int i = 0; i < n; i++) {
+            if (fixed[i]) continue;
+            const double m = 1.0 / invm[i];
+            double v2 = 0;
+            for (int c = 0; c < 3; c++) {
+                const double F = f[3 * i + c] + (fe ? fe[3 * i + c] : 0.0) + m * d->gravity[c];
+                const double T = t[3 * i + c] + (te ? te[3 * i + c] : 0.0);
+                const double hv = h * invm[i] * local_damping(F, v[3 * i + c], alpha);
+                const double hw = h * invI[i] * local_damping(T, w[3 * i + c], alpha);
+                v[3 * i + c] += kick * hv;
+                dv[3 * i + c] = hv;
+                x[3 * i + c] += dt * v[3 * i + c];
+                w[3 * i + c] += kick * hw;
+                dw[3 * i + c] = hw;
+                v2 += v[3 * i + c] * v[3 * i + c];
+            }
+            if (v2 > vmax2) vmax2 = v2;
+        }
+    } else if (d->use_ext) {
         const double *restrict fe = d->fext, *restrict te = d->text;
 #pragma omp parallel for num_threads(d->nthreads) if (d->nthreads > 1) reduction(max : vmax2) schedule(static)
         for (int i = 0; i < n; i++) {
@@ -363,6 +397,13 @@ void dem_sync_velocities(dem_t *d)
                 fa += d->fext[3 * i + c];
                 ta += d->text[3 * i + c];
             }
+            if (d->damping > 0) {
+                /* the same damped resultant as kick_drift */
+                const double m = 1.0 / d->invm[i];
+                d->v[3 * i + c] += im * local_damping(fa + m * d->gravity[c], d->v[3 * i + c], d->damping);
+                d->w[3 * i + c] += ii * local_damping(ta, d->w[3 * i + c], d->damping);
+                continue;
+            }
             d->v[3 * i + c] += fa * im + h * d->gravity[c];
             d->w[3 * i + c] += ta * ii;
         }
@@ -426,6 +467,16 @@ static dem_status_t step_once(dem_t *d)
     for (int w = 0; w < d->nwall; w++) {
         dem_wall_t *W = &d->wall[w];
         if (!W->active) continue;
+        if (W->mass > 0) {
+            /* a load-controlled wall: leap-frog like the particles, with the
+             * particles' force on it from the last force computation and the
+             * same local damping */
+            double vn = 0, fn = W->push;
+            for (int a = 0; a < 3; a++) vn += W->vel[a] * W->n[a], fn += W->force[a] * W->n[a];
+            if (d->damping > 0) fn = local_damping(fn, vn, d->damping);
+            vn += dt * fn / W->mass;
+            for (int a = 0; a < 3; a++) W->vel[a] = vn * W->n[a];
+        }
         const double s = sqrt(W->vel[0] * W->vel[0] + W->vel[1] * W->vel[1] + W->vel[2] * W->vel[2]);
         if (s > 0) {
             for (int a = 0; a < 3; a++) W->p[a] += dt * W->vel[a];
@@ -543,6 +594,21 @@ void dem_wall_force(const dem_t *d, int w, double f[3])
     for (int a = 0; a < 3; a++) f[a] = d->wall[w].force[a];
 }
 int dem_wall_active(const dem_t *d, int w) { return d->wall[w].active; }
+void dem_wall_position(const dem_t *d, int w, double p[3])
+{
+    for (int a = 0; a < 3; a++) p[a] = d->wall[w].p[a];
+}
+void dem_wall_set_load(dem_t *d, int w, double push, double mass)
+{
+    d->wall[w].push = push;
+    d->wall[w].mass = mass;
+}
+int dem_wall_find(const dem_t *d, const char *name)
+{
+    for (int w = 0; w < d->nwall; w++)
+        if (!strcmp(d->wall[w].name, name)) return w;
+    return -1;
+}
 const char *dem_wall_name(const dem_t *d, int w) { return d->wall[w].name; }
 
 double dem_memory_per_particle(const dem_t *d)

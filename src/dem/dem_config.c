@@ -16,7 +16,13 @@
          "normal of extra wall " #N ", pointing to the particles' side"},                                         \
         {"walls", "wall" #N "_velocity", CFG_VEC3, "0 0 0", -BIG, BIG, NULL, "velocity of extra wall " #N " (m/s)"}, \
         {"walls", "wall" #N "_remove_time", CFG_DOUBLE, "-1", -1, BIG, NULL,                                      \
-         "time at which extra wall " #N " is removed (s; -1: never), e.g. the gate of a column collapse"}
+         "time at which extra wall " #N " is removed (s; -1: never), e.g. the gate of a column collapse"},        \
+        {"walls", "wall" #N "_force", CFG_DOUBLE, "0", 0, BIG, NULL,                                              \
+         "load-controlled extra wall " #N " (a piston): force pushing it along its normal (N); needs wall" #N     \
+         "_mass"},                                                                                                \
+        {"walls", "wall" #N "_mass", CFG_DOUBLE, "0", 0, BIG, NULL,                                               \
+         "mass of the load-controlled extra wall " #N " (kg; 0: the wall follows wall" #N "_velocity); at least " \
+         "the mass of the grains it touches, for the DEM time step"}
 
 static const cfg_key_t dem_keys[] = {
     /* [particles] */
@@ -96,6 +102,9 @@ static const cfg_key_t dem_keys[] = {
     {"packing", "output", CFG_STRING, "packing.h5", 1, 0, NULL, "file (in the output directory) of the settled packing"},
     /* [dem] */
     {"dem", "gravity", CFG_VEC3, "0 0 -9.81", -BIG, BIG, NULL, "gravity (m/s^2), any direction"},
+    {"dem", "damping", CFG_DOUBLE, "0", 0, 0.99, NULL,
+     "local non-viscous damping alpha (Cundall): every force and torque component F - alpha |F| sgn(v); "
+     "0: off. For quasi-static loading (oedometer): it vanishes at equilibrium"},
     {"dem", "steps_per_contact", CFG_INT, "50", 20, 1000000, NULL, "n_c: time step dt = t_c / n_c"},
     {"dem", "dt", CFG_DOUBLE, "0", 0, BIG, NULL, "time step (s); 0: t_c / steps_per_contact; must be <= t_c/20"},
     {"dem", "skin", CFG_DOUBLE, "0.1", 1e-4, 2, NULL, "Verlet skin as a fraction of the largest diameter"},
@@ -176,6 +185,12 @@ static void config_walls(dem_t *d, cfg_t *cfg)
         const double tr = cfg_double(cfg, "walls", kr);
         snprintf(name, sizeof name, "wall%d", w);
         dem_add_wall(d, name, p, n, v, tr < 0 ? INFINITY : tr);
+        char kf[32], km[32];
+        snprintf(kf, sizeof kf, "wall%d_force", w);
+        snprintf(km, sizeof km, "wall%d_mass", w);
+        const double push = cfg_double(cfg, "walls", kf), mass = cfg_double(cfg, "walls", km);
+        if (push > 0 && mass <= 0) cfg_fail(cfg, "walls", kf, "a load-controlled wall needs a mass (wall%d_mass > 0)", w);
+        dem_wall_set_load(d, d->nwall - 1, push, mass);
     }
 }
 
@@ -597,6 +612,7 @@ dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
     d->skin_rel = cfg_double(cfg, "dem", "skin");
     d->sort_every = cfg_int(cfg, "dem", "sort_every");
     d->max_overlap_allowed = cfg_double(cfg, "dem", "max_overlap");
+    d->damping = cfg_double(cfg, "dem", "damping");
     d->parallel_mode = cfg_enum(cfg, "dem", "parallel");
     d->nthreads = cfg_int(cfg, "dem", "threads");
 #ifndef _OPENMP

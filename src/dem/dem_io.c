@@ -286,6 +286,7 @@ void dem_checkpoint_write_loc(dem_t *d, hid_t f)
         write_attr_d(g, "normal", W->n, 3);
         const double act = W->active;
         write_attr_d(g, "active", &act, 1);
+        write_attr_d(g, "velocity", W->vel, 3); /* a load-controlled wall's changes */
         long nw = 0;
         for (int e = 0; e < W->nlist; e++) nw += W->on[e];
         long *wid = malloc(((size_t)nw + 1) * sizeof(long));
@@ -502,6 +503,7 @@ void dem_checkpoint_read_loc(dem_t *d, hid_t f, const char *path)
         double act = 1;
         read_attr_d(g, "point", W->p);
         read_attr_d(g, "active", &act);
+        if (H5Aexists(g, "velocity") > 0) read_attr_d(g, "velocity", W->vel);
         W->active = act != 0;
         const long nw = ds_length(g, "ids");
         long *wid = malloc(((size_t)nw + 1) * sizeof(long));

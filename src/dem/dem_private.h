@@ -24,6 +24,10 @@ typedef struct {
     double n[3];     /* unit normal pointing to the particles' side */
     double vel[3];   /* velocity (translation) */
     double remove_time; /* the wall disappears at this time (INFINITY: never) */
+    /* load-controlled wall (a piston): pushed along n by `push` (N) and moved
+     * by Newton's law with its mass (kg) against the particles' force; mass 0:
+     * the wall follows its prescribed velocity */
+    double push, mass;
     int active;
     double moved;    /* distance moved since the last list build */
     /* contact list: particles within r + skin at the last build */
@@ -130,6 +134,7 @@ struct dem {
     long step;
     double gravity[3];
     double max_overlap_allowed;
+    double damping;      /* local non-viscous damping coefficient α (Cundall): F − α|F| sgn(v), 0: off */
     int ready;           /* lists built and forces of the current state computed */
     int hist_update;     /* 0 while computing the forces of the initial state */
     int use_ext;         /* the external force/torque arrays were handed out */
