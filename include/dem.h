@@ -135,6 +135,8 @@ const char *dem_wall_name(const dem_t *d, int w);
 int dem_wall_find(const dem_t *d, const char *name);
 /* A point of wall w (it moves with the wall). */
 void dem_wall_position(const dem_t *d, int w, double p[3]);
+/* Move wall w (between steps) so that its plane passes through p. */
+void dem_wall_set_point(dem_t *d, int w, const double p[3]);
 /* Make wall w a piston: pushed along its normal (towards the particles) by
  * the force `push` (N) and moved by Newton's law with its mass (kg) and the
  * particles' force ([walls] wall<N>_force / wall<N>_mass); mass 0: back to

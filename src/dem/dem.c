@@ -598,6 +598,11 @@ void dem_wall_position(const dem_t *d, int w, double p[3])
 {
     for (int a = 0; a < 3; a++) p[a] = d->wall[w].p[a];
 }
+void dem_wall_set_point(dem_t *d, int w, const double p[3])
+{
+    for (int a = 0; a < 3; a++) d->wall[w].p[a] = p[a];
+    d->ready = 0; /* the wall's contact list */
+}
 void dem_wall_set_load(dem_t *d, int w, double push, double mass)
 {
     d->wall[w].push = push;
