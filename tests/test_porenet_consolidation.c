@@ -91,12 +91,20 @@ static double surface_z(const dem_t *d, const oedo_t *o)
  * case takes the kinetic energy away and does not change the equilibrium);
  * at rest when the piston moved by less than tol in 100 steps.  Returns the
  * piston height. */
+/* wall time and count of the dry DEM steps (the cost of a coupled step is
+ * reported relative to a dry one of the same packing) */
+static double dry_time;
+static long dry_steps;
+
 static double relax_dry(dem_t *d, const oedo_t *o, double sigma, double tol)
 {
     set_load(d, o, sigma);
     double h = piston_z(d, o);
     for (int k = 0; k < 2000; k++) {
+        const double t0 = wtime();
         assert_int_equal(dem_run_steps(d, 100), DEM_OK);
+        dry_time += wtime() - t0;
+        dry_steps += 100;
         const double h1 = piston_z(d, o);
         if (getenv("PN_TRACE") && mpi_rank() == 0) printf("# dry %d: piston %.9g\n", k, h1);
         if (k > 3 && fabs(h1 - h) < tol) return o->ntop ? surface_z(d, o) : h1;
@@ -126,10 +134,11 @@ typedef struct {
     long steps, retri;
     double t_step;      /* wall time per coupled step (DEM + network) */
     double dt;
+    int ntv;            /* T_v values reached */
 } wet_t;
 
 static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, double sigma, double dsig, double H,
-                     double dH, double cv, double eps_retri, FILE *series, const char *label)
+                     double L, double dH, double cv, double eps_retri, FILE *series, const char *label)
 {
     wet_t w = {0};
     dem_t *d = dem_create_from_config(cfg, MPI_COMM_WORLD);
@@ -145,14 +154,21 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
     const double g0[3] = {0, 0, 0};
     assert_int_equal(pn_model_couple_dem(&m, d, g0, 0.0), 0);
     set_load(d, o, sigma + dsig);
+    if (getenv("PN_WET_DAMPING")) dem_set_damping(d, atof(getenv("PN_WET_DAMPING")));
     /* one DEM step per coupled step, within the viscous limit (thesis 4.21) */
-    const double dt = fmin(pn_coupled_dt(&m, d), dem_dt(d)), L = H;
+    const double dt = fmin(pn_coupled_dt(&m, d), dem_dt(d));
     w.dt = dt;
     if (getenv("PN_TRACE") && mpi_rank() == 0)
         printf("# wet: dt %.3g s (viscous limit x dt_factor %.3g, DEM %.3g)\n", dt, pn_coupled_dt(&m, d), dem_dt(d));
     const double t0 = dem_time(d), w0 = wtime();
     int next = 0;
-    while (next < 4) {
+    /* PN_STEPS: stop after this many steps (timing runs) */
+    const long max_steps = getenv("PN_STEPS") ? atol(getenv("PN_STEPS")) : -1;
+    /* PN_TV_MAX: stop after the last T_v of the list not above it (reference runs) */
+    int ntv = 4;
+    if (getenv("PN_TV_MAX"))
+        while (ntv > 1 && TV[ntv - 1] > atof(getenv("PN_TV_MAX")) + 1e-12) ntv--;
+    while (next < ntv && w.steps != max_steps) {
         const dem_status_t st = dem_advance(d, dem_time(d) + dt);
         if (st != DEM_OK) fprintf(stderr, "wet step %ld: %s\n", w.steps, dem_error(d));
         assert_int_equal(st, DEM_OK);
@@ -163,7 +179,8 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
         const double pm = band_pressure(&m, 0.45 * H, 0.55 * H, &w.zmid) / dsig;
         const double pb = band_pressure(&m, -1, 0.1 * H, &w.zbase) / dsig, U = (z0 - surface_z(d, o)) / dH;
         w.pmax = fmax(w.pmax, pb);
-        if (series && w.steps % 5 == 0) fprintf(series, "%s,%.6g,%.6g,%.6g,%.6g\n", label, T, pm, pb, U);
+        if (series && w.steps % 20 == 0)
+            fprintf(series, "%s,%.6g,%.6g,%.6g,%.6g,%.4f,%.4f\n", label, T, pm, pb, U, w.zmid / L, w.zbase / L);
         if (getenv("PN_TRACE") && w.steps % 100 == 0 && mpi_rank() == 0)
             printf("# wet %ld: T %.4g pmid %.4f pbase %.4f U %.4f\n", w.steps, T, pm, pb, U);
         if (getenv("PN_PROFILE") && mpi_rank() == 0 && w.steps % 500 == 0) {
@@ -193,6 +210,7 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
         }
     }
     w.t_step = (wtime() - w0) / w.steps;
+    w.ntv = next;
     free(zinit);
     w.retri = m.n_retri;
     pn_model_free(&m);
@@ -258,11 +276,29 @@ static void test_consolidation(void **state)
             if (x[3 * i + 2] + r[i] > zp) o.top[id[i]] = 1, o.ntop++;
     }
     const double h0 = surface_z(d, &o), zpiston = piston_z(d, &o);
+    double *zs0 = calloc((size_t)n, sizeof *zs0);
+    for (int i = 0; i < n; i++) zs0[dem_ids(d)[i]] = dem_positions(d)[3 * i + 2];
     char s0[512];
     snprintf(s0, sizeof s0, "%s/s0.h5", dir);
     dem_write_checkpoint(d, s0);
+    dry_time = 0;
+    dry_steps = 0;
     const double h1 = relax_dry(d, &o, sigma0 + dsig, rest_tol);
+    const double t_dry = dry_time / dry_steps;
     const double dH_piston = zpiston - piston_z(d, &o);
+    if (getenv("PN_PROFILE") && mpi_rank() == 0) {
+        double sd[12] = {0}, cd[12] = {0};
+        for (int i = 0; i < n; i++) {
+            const int b = (int)(zs0[dem_ids(d)[i]] / (0.1 * h0));
+            if (b >= 0 && b < 12) sd[b] += zs0[dem_ids(d)[i]] - dem_positions(d)[3 * i + 2], cd[b]++;
+        }
+        printf("# dry disp:");
+        for (int b = 0; b < 12; b++) printf(" %.3f", cd[b] ? sd[b] / cd[b] / (h0 - h1) : 0);
+        printf("\n");
+        fflush(stdout);
+        if (getenv("PN_DRY_ONLY")) exit(0);
+    }
+    free(zs0);
     const double H = h0, dH = h0 - h1, Eoed = dsig * H / dH;
 
     /* permeameter on S₀: p = 1 at the base, 0 at the top of the network, two
@@ -291,6 +327,11 @@ static void test_consolidation(void **state)
         sz += z, sp += m.p[i], szz += z * z, szp += z * m.p[i], c++;
     }
     const double grad = (c * szp - sz * sp) / (c * szz - sz * sz);
+    /* the drained face as the flow sees it: where the central pressure line
+     * reaches the top pressure (0); the loose layer of grains under the
+     * piston, about one diameter, is nearly as open as the fluid above it */
+    const double zdrain = -((sp - grad * sz) / c) / grad;
+    const double L = getenv("PN_L_IS_H") ? H : zdrain;
     const double mu = m.prm.mu, kappa = mu * (q[4] / o.area) / -grad;
     const double cv = kappa * Eoed / mu;
     pn_model_free(&m);
@@ -299,36 +340,40 @@ static void test_consolidation(void **state)
     if (getenv("PN_SERIES") && mpi_rank() == 0) {
         series = fopen(getenv("PN_SERIES"), "w");
         assert_non_null(series);
-        fprintf(series, "run,Tv,pmid,pbase,U\n");
+        fprintf(series, "run,Tv,pmid,pbase,U,zmid_over_H,zbase_over_H\n");
     }
     const double eps_default = cfg_double(cfg, "porenet", "retriangulate");
-    const wet_t w = run_wet(cfg, s0, &o, hnet, sigma0, dsig, H, dH, cv, eps_default, series, "default");
+    const wet_t w = run_wet(cfg, s0, &o, hnet, sigma0, dsig, H, L, dH, cv, eps_default, series, "default");
     if (mpi_rank() == 0) {
         printf("# consolidation: %d spheres (%d under the piston), H = %.4g m, E_oed = %.4g Pa (strain %.2e; from "
                "the piston %.4g Pa), kappa = %.4g m^2 (kappa/d^2 = %.3g), mu = %g Pa s, C_v = %.4g m^2/s, dt = %.3g s; "
                "%ld coupled steps to T_v = 1, %ld triangulations (retriangulate = %g), %.3g ms per step; largest "
-               "p_base/dsigma %.3f\n",
+               "p_base/dsigma %.3f; dry DEM step %.3g ms (coupled/dry %.2f)\n",
                n, o.ntop, H, Eoed, dH / H, dsig * zpiston / dH_piston, kappa, kappa / (4 * rm * rm), mu, cv, w.dt,
-               w.steps, w.retri, eps_default, 1e3 * w.t_step, w.pmax);
-        printf("#   bands: mid-height z/H = %.3f, base z/H = %.3f\n", w.zmid / H, w.zbase / H);
-        for (int k = 0; k < 4; k++)
+               w.steps, w.retri, eps_default, 1e3 * w.t_step, w.pmax, 1e3 * t_dry, w.t_step / t_dry);
+        printf("#   drainage path L = %.4g m (drained face from the permeameter; L/H = %.4f), T_v = C_v t/L^2; bands: "
+               "mid-height z/L = %.3f, base z/L = %.3f\n",
+               L, zdrain / H, w.zmid / L, w.zbase / L);
+        for (int k = 0; k < w.ntv; k++)
             printf("#   T_v = %.1f: p_mid/dsigma = %.4f (Terzaghi %.4f), p_base/dsigma = %.4f (Terzaghi %.4f), U = %.4f "
                    "(Terzaghi %.4f)\n",
-                   TV[k], w.pmid[k], terzaghi_p(w.zmid / H, TV[k]), w.pbase[k], terzaghi_p(w.zbase / H, TV[k]), w.U[k],
+                   TV[k], w.pmid[k], terzaghi_p(w.zmid / L, TV[k]), w.pbase[k], terzaghi_p(w.zbase / L, TV[k]), w.U[k],
                    terzaghi_U(TV[k]));
     }
-    /* §5.4: ±0.05 against the series */
-    for (int k = 0; k < 4; k++) {
-        assert_true(fabs(w.pmid[k] - terzaghi_p(w.zmid / H, TV[k])) < 0.05);
-        assert_true(fabs(w.pbase[k] - terzaghi_p(w.zbase / H, TV[k])) < 0.05);
-        assert_true(fabs(w.U[k] - terzaghi_U(TV[k])) < 0.05);
+    double dev = 0; /* largest deviation from the series */
+    const int ntv = w.ntv;
+    for (int k = 0; k < ntv; k++) {
+        dev = fmax(dev, fabs(w.pmid[k] - terzaghi_p(w.zmid / L, TV[k])));
+        dev = fmax(dev, fabs(w.pbase[k] - terzaghi_p(w.zbase / L, TV[k])));
+        dev = fmax(dev, fabs(w.U[k] - terzaghi_U(TV[k])));
     }
+    if (mpi_rank() == 0) printf("# largest deviation from Terzaghi: %.4f\n", dev);
+    double worst = 0;
     if (getenv("PN_REFERENCE")) {
-        const wet_t e = run_wet(cfg, s0, &o, hnet, sigma0, dsig, H, dH, cv, 0.0, series, "every_step");
-        double worst = 0;
+        const wet_t e = run_wet(cfg, s0, &o, hnet, sigma0, dsig, H, L, dH, cv, 0.0, series, "every_step");
         if (mpi_rank() == 0)
             printf("# re-triangulating every step: %ld triangulations, %.3g ms per step\n", e.retri, 1e3 * e.t_step);
-        for (int k = 0; k < 4; k++) {
+        for (int k = 0; k < ntv && k < e.ntv; k++) {
             if (mpi_rank() == 0)
                     printf("#   T_v = %.1f: p_mid/dsigma = %.4f (default %.4f), p_base/dsigma = %.4f (default %.4f), U = %.4f "
                        "(default %.4f)\n",
@@ -337,10 +382,12 @@ static void test_consolidation(void **state)
             worst = fmax(worst, fabs(e.pbase[k] - w.pbase[k]));
         }
         if (mpi_rank() == 0) printf("# largest difference (of Δσ, of ΔH): %.4f\n", worst);
-        /* §5.4: the default criterion agrees with every-step re-triangulation within 2 % */
-        assert_true(worst < 0.02);
     }
     if (series) fclose(series);
+    /* §5.4: ±0.05 against the series */
+    assert_true(dev < 0.05);
+    /* §5.4: the default criterion agrees with every-step re-triangulation within 2 % */
+    assert_true(worst < 0.02);
     if (mpi_rank() == 0) {
         char pk[600];
         snprintf(pk, sizeof pk, "%s/%s", dir, cfg_string(cfg, "packing", "output"));
