@@ -289,7 +289,7 @@ static double kick_drift(dem_t *d)
     const unsigned char *restrict fixed = d->fixed;
     const int n = d->n;
     double vmax2 = 0.0;
-    if (d->damping > 0) {
+    if (d->use_ext || d->damping > 0) {
         /* local non-viscous damping (Cundall & Strack 1979; Yade's
          * NewtonIntegrator): each component of the resultant force (gravity
          * and external forces included) and torque becomes F − α|F| sgn(v),
@@ -298,36 +298,19 @@ static double kick_drift(dem_t *d)
          * half-cycle of a linear oscillator) and vanishes at equilibrium, so
          * it changes neither the static state nor a quasi-static path. */
         const double alpha = d->damping;
-        const double *fe = d->use_ext ? d->fext : NULL, *te = d->use_ext ? d->text : NULL;
-        for (int i = 0; i < n; i++) {
-            if (fixed[i]) continue;
-            const double m = 1.0 / invm[i];
-            double v2 = 0;
-            for (int c = 0; c < 3; c++) {
-                const double F = f[3 * i + c] + (fe ? fe[3 * i + c] : 0.0) + m * d->gravity[c];
-                const double T = t[3 * i + c] + (te ? te[3 * i + c] : 0.0);
-                const double hv = h * invm[i] * local_damping(F, v[3 * i + c], alpha);
-                const double hw = h * invI[i] * local_damping(T, w[3 * i + c], alpha);
-                v[3 * i + c] += kick * hv;
-                dv[3 * i + c] = hv;
-                x[3 * i + c] += dt * v[3 * i + c];
-                w[3 * i + c] += kick * hw;
-                dw[3 * i + c] = hw;
-                v2 += v[3 * i + c] * v[3 * i + c];
-            }
-            if (v2 > vmax2) vmax2 = v2;
-        }
-    } else if (d->use_ext) {
-        const double *restrict fe = d->fext, *restrict te = d->text;
+        const double *restrict fe = d->use_ext ? d->fext : NULL, *restrict te = d->use_ext ? d->text : NULL;
 #pragma omp parallel for num_threads(d->nthreads) if (d->nthreads > 1) reduction(max : vmax2) schedule(static)
         for (int i = 0; i < n; i++) {
             if (fixed[i]) continue;
             const double im = invm[i], ii = invI[i];
-            const double a[3] = {(f[3 * i] + fe[3 * i]) * im + gx, (f[3 * i + 1] + fe[3 * i + 1]) * im + gy,
-                                 (f[3 * i + 2] + fe[3 * i + 2]) * im + gz};
+            const double g[3] = {gx, gy, gz};
             double v2 = 0;
             for (int c = 0; c < 3; c++) {
-                const double hv = h * a[c], hw = h * (t[3 * i + c] + te[3 * i + c]) * ii;
+                const double F = f[3 * i + c] + (fe ? fe[3 * i + c] : 0.0);
+                const double T = t[3 * i + c] + (te ? te[3 * i + c] : 0.0);
+                const double hv = alpha > 0 ? h * im * local_damping(F + g[c] / im, v[3 * i + c], alpha)
+                                            : h * (F * im + g[c]);
+                const double hw = alpha > 0 ? h * ii * local_damping(T, w[3 * i + c], alpha) : h * T * ii;
                 v[3 * i + c] += kick * hv;
                 dv[3 * i + c] = hv;
                 x[3 * i + c] += dt * v[3 * i + c];
