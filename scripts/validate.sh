@@ -83,6 +83,28 @@ else
 fi
 rm -rf "$d"
 
+# --- porenet: Terzaghi consolidation in an oedometer (cases/consolidation/oedometer.ini,
+# 600 spheres, 22 grains high; catalano_pfv.md §5.4): p at mid-height and at the sealed base
+# and U against the series at T_v = 0.1, 0.2, 0.5, 1 within ±0.05 (PN_TOL), E_oed and kappa
+# measured on the same packing; figure consolidation.png.  About 65 000 coupled steps
+# (~10 min of one core).  Then the coarse column (300 spheres) to T_v = 0.2 with the default
+# re-triangulation criterion (1 %) and re-triangulating at every step: within 0.02 of dsigma
+# and of the settlement (PN_TOL=1: only that comparison is asserted there).
+section "porenet: Terzaghi consolidation (oedometer, 600 spheres)"
+PN_CASE=cases/consolidation/oedometer.ini PN_TOL=0.05 PN_SERIES="$OUT/consolidation.csv" \
+    $MPIRUN -np 1 "$BUILD/tests/test_porenet_consolidation" >"$OUT/consolidation.txt" 2>&1
+rc=$?
+grep '^#' "$OUT/consolidation.txt"
+/usr/bin/python3 postproc/plot_consolidation.py "$OUT/consolidation.csv" "$OUT/consolidation.png"
+[ "$rc" = 0 ] || fail "porenet consolidation (Terzaghi within 0.05)"
+section "porenet: consolidation, 1 % re-triangulation criterion against every step"
+PN_REFERENCE=1 PN_TV_MAX=0.2 PN_TOL=1 PN_SERIES="$OUT/consolidation_retri.csv" \
+    $MPIRUN -np 1 "$BUILD/tests/test_porenet_consolidation" >"$OUT/consolidation_retri.txt" 2>&1
+rc=$?
+grep '^#' "$OUT/consolidation_retri.txt"
+/usr/bin/python3 postproc/plot_consolidation.py "$OUT/consolidation_retri.csv" "$OUT/consolidation_retri.png"
+[ "$rc" = 0 ] || fail "porenet consolidation (1 % against every step)"
+
 
 # --- fluid: lid-driven cavity series, Re = 100 (Crank-Nicolson) and Re = 1000
 # (explicit) on 64^2, 128^2, 256^2 to steady state, Richardson-extrapolated with
