@@ -45,7 +45,7 @@ for run in dict.fromkeys(rows["run"]):
 for t in (0.1, 0.2, 0.5, 1.0):
     for a in ax:
         a.axvline(t, color="0.85", lw=0.8, zorder=0)
-ax[0].set_xlabel("$T_v = C_v t/H^2$")
+ax[0].set_xlabel("$T_v = C_v t/L^2$")
 ax[0].set_ylabel(r"$p/\Delta\sigma$")
 ax[1].set_xlabel("$T_v$")
 ax[1].set_ylabel("U = settlement / dry settlement")

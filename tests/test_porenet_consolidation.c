@@ -225,6 +225,11 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
     w.ntv = next;
     free(zinit);
     w.retri = m.n_retri;
+    if (mpi_rank() == 0)
+        printf("# %s: %ld steps, %ld triangulations (last: triangulation %.3g ms, network %.3g ms, factorisation "
+               "%.3g ms); per step (wall): volume rates %.3g ms, back-solve %.3g ms, forces %.3g ms\n",
+               label, w.steps, m.n_retri, 1e3 * m.t_tri, 1e3 * m.t_net, 1e3 * m.t_factor, 1e3 * m.t_vol / w.steps,
+               1e3 * m.t_solve / w.steps, 1e3 * m.t_force / w.steps);
     pn_model_free(&m);
     dem_free(d);
     return w;
