@@ -126,6 +126,9 @@ static void test_bad_keys(void **state)
         {"[contact]\nrestitution = 0.5\ncontact_time = 1e-4\nfriction = 0.5\n[particles]\nsource = insert\n"
          "radius = 1e-3\ncount = 10\nvolume_fraction = 0.1\n",
          "give either count or volume_fraction"},
+        {"[contact]\nrestitution = 0.5\ncontact_time = 1e-4\nfriction = 0.5\n[walls]\nwall1_point = 0 0 0.01\n"
+         "wall1_normal = 0 0 -1\nwall1_force = 1\n",
+         "walls.wall1_force: a load-controlled wall needs a mass"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
         char text[2048];
