@@ -36,7 +36,7 @@
 
 static const double TV[4] = {0.1, 0.2, 0.5, 1.0};
 /* bound on the deviation from the series of the coarse case (see the end of test_consolidation) */
-#define COARSE_TOL 0.2
+#define COARSE_TOL 0.12
 
 /* Terzaghi's series (catalano_pfv.md §2.2), drained face at z = L, sealed
  * base at z = 0 (the drainage path L = H), M = (2m+1)π/2:
@@ -92,10 +92,6 @@ static double surface_z(const dem_t *d, const oedo_t *o)
     return h / o->ntop;
 }
 
-/* Dry: under the load σ to the static equilibrium (the local damping of the
- * case takes the kinetic energy away and does not change the equilibrium);
- * at rest when the piston moved by less than tol in 100 steps.  Returns the
- * piston height. */
 /* CPU time of this process: the machine is shared, the wall time of a step
  * depends on the other jobs, the CPU time much less */
 static double cpu_time(void)
@@ -110,15 +106,24 @@ static double cpu_time(void)
 static double dry_time;
 static long dry_steps;
 
-static double relax_dry(dem_t *d, const oedo_t *o, double sigma, double tol)
+static void dry_steps_run(dem_t *d, long n)
 {
-    set_load(d, o, sigma);
+    const double t0 = cpu_time();
+    assert_int_equal(dem_run_steps(d, n), DEM_OK);
+    dry_time += cpu_time() - t0;
+    dry_steps += n;
+}
+
+/* Dry, under the current load, to the static equilibrium (the local damping
+ * of the case takes the kinetic energy away and does not change the
+ * equilibrium): at rest when the piston moved by less than tol in 100
+ * steps.  Returns the height of the sample (the piston's before the grains
+ * under it are known). */
+static double relax_loaded(dem_t *d, const oedo_t *o, double tol)
+{
     double h = piston_z(d, o);
     for (int k = 0; k < 2000; k++) {
-        const double t0 = cpu_time();
-        assert_int_equal(dem_run_steps(d, 100), DEM_OK);
-        dry_time += cpu_time() - t0;
-        dry_steps += 100;
+        dry_steps_run(d, 100);
         const double h1 = piston_z(d, o);
         if (getenv("PN_TRACE") && mpi_rank() == 0) printf("# dry %d: piston %.9g\n", k, h1);
         if (k > 3 && fabs(h1 - h) < tol) return o->ntop ? surface_z(d, o) : h1;
@@ -126,6 +131,13 @@ static double relax_dry(dem_t *d, const oedo_t *o, double sigma, double tol)
     }
     fail_msg("the dry oedometer did not come to rest");
     return h;
+}
+
+/* Dry: the load σ at once, then to rest. */
+static double relax_dry(dem_t *d, const oedo_t *o, double sigma, double tol)
+{
+    set_load(d, o, sigma);
+    return relax_loaded(d, o, tol);
 }
 
 /* Mean pore pressure in the band zlo < z < zhi, and the mean height of its
@@ -302,6 +314,8 @@ static void test_consolidation(void **state)
     dem_write_checkpoint(d, s0);
     dry_time = 0;
     dry_steps = 0;
+    /* the load step at once, as on the saturated sample (a ramp over 10⁴
+     * steps gave a 4 % stiffer E_oed and no closer agreement) */
     const double h1 = relax_dry(d, &o, sigma0 + dsig, rest_tol);
     const double t_dry = dry_time / dry_steps;
     const double dH_piston = zpiston - piston_z(d, &o);
