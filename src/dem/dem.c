@@ -482,7 +482,11 @@ void dem_full_velocity(const dem_t *d, int i, double vel[3])
     for (int c = 0; c < 3; c++) {
         double fa = d->f[3 * i + c];
         if (d->use_ext) fa += d->fext[3 * i + c];
-        vel[c] = d->v[3 * i + c] + (d->fixed[i] ? 0.0 : h * (fa * d->invm[i] + d->gravity[c]));
+        if (d->damping > 0 && !d->fixed[i]) /* the damped resultant of the closing kick */
+            vel[c] = d->v[3 * i + c] +
+                     h * d->invm[i] * local_damping(fa + d->gravity[c] / d->invm[i], d->v[3 * i + c], d->damping);
+        else
+            vel[c] = d->v[3 * i + c] + (d->fixed[i] ? 0.0 : h * (fa * d->invm[i] + d->gravity[c]));
     }
 }
 
