@@ -91,20 +91,23 @@ rm -rf "$d"
 # section fails, docs/validation.md).  Then the coarse column (300 spheres) to T_v = 0.2 with the default
 # re-triangulation criterion (1 %) and re-triangulating at every step: within 0.02 of dsigma
 # and of the settlement (PN_TOL=1: only that comparison is asserted there).
+# consolidation NAME WHAT VAR=VALUE...: the test with these settings, its numbers, its figure
+consolidation() {
+    local name=$1 what=$2
+    shift 2
+    env "$@" PN_SERIES="$OUT/$name.csv" $MPIRUN -np 1 "$BUILD/tests/test_porenet_consolidation" \
+        >"$OUT/$name.txt" 2>&1
+    local rc=$?
+    grep '^#' "$OUT/$name.txt"
+    /usr/bin/python3 postproc/plot_consolidation.py "$OUT/$name.csv" "$OUT/$name.png"
+    [ "$rc" = 0 ] || fail "$what"
+}
 section "porenet: Terzaghi consolidation (oedometer, 600 spheres)"
-PN_CASE=cases/consolidation/oedometer.ini PN_TOL=0.05 PN_SERIES="$OUT/consolidation.csv" \
-    $MPIRUN -np 1 "$BUILD/tests/test_porenet_consolidation" >"$OUT/consolidation.txt" 2>&1
-rc=$?
-grep '^#' "$OUT/consolidation.txt"
-/usr/bin/python3 postproc/plot_consolidation.py "$OUT/consolidation.csv" "$OUT/consolidation.png"
-[ "$rc" = 0 ] || fail "porenet consolidation (Terzaghi within 0.05)"
+consolidation consolidation "porenet consolidation (Terzaghi within 0.05)" \
+    PN_CASE=cases/consolidation/oedometer.ini PN_TOL=0.05
 section "porenet: consolidation, 1 % re-triangulation criterion against every step"
-PN_REFERENCE=1 PN_TV_MAX=0.2 PN_TOL=1 PN_SERIES="$OUT/consolidation_retri.csv" \
-    $MPIRUN -np 1 "$BUILD/tests/test_porenet_consolidation" >"$OUT/consolidation_retri.txt" 2>&1
-rc=$?
-grep '^#' "$OUT/consolidation_retri.txt"
-/usr/bin/python3 postproc/plot_consolidation.py "$OUT/consolidation_retri.csv" "$OUT/consolidation_retri.png"
-[ "$rc" = 0 ] || fail "porenet consolidation (1 % against every step)"
+consolidation consolidation_retri "porenet consolidation (1 % against every step)" \
+    PN_REFERENCE=1 PN_TV_MAX=0.2 PN_TOL=1
 
 
 # --- fluid: lid-driven cavity series, Re = 100 (Crank-Nicolson) and Re = 1000
