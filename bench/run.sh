@@ -44,6 +44,10 @@ if want multigrid; then
 fi
 if want porenet && [ -x "$BUILD/bench/bench_porenet" ]; then
     run porenet $MPIRUN -np 1 "$BUILD/bench/bench_porenet" 5000 20000
+    # against YADE's FlowEngine on the same packings (installs yade)
+    run porenet_yade bash bench/porenet_vs_yade.sh
+    [ -f "$BUILD/bench_porenet_yade/porenet_yade.md" ] &&
+        sed 's/^/[porenet_yade] /' "$BUILD/bench_porenet_yade/porenet_yade.md" >>"$RES"
 fi
 if want ibm && [ -x "$BUILD/bench/bench_ibm" ]; then
     for np in 1 2; do run ibm_np$np $MPIRUN -np $np "$BUILD/bench/bench_ibm"; done

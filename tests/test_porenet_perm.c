@@ -29,7 +29,7 @@ static void case_build(pn_case_t *c, const pn_domain_t *dom, int n, const double
                        pn_solver_kind_t kind)
 {
     char err[512] = "";
-    pn_params_t prm = {0.5, 1.0};
+    pn_params_t prm = {0.5, 1.0, PN_WALL_MIRROR};
     memset(c, 0, sizeof *c);
     c->n = n;
     int rc = pn_triangulate(dom, n, x, r, margin, &c->tri, err, sizeof err);
