@@ -31,7 +31,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include <mpi.h>
 
@@ -41,15 +40,6 @@
 #include "porenet.h"
 #include "porenet_packing.h"
 #include "util.h"
-
-/* CPU time of the process: the machine is shared, the wall time of a loaded
- * core overstates the cost (both codes run single-threaded). */
-static double cputime(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
 
 /* A configuration text for the box [0, L]³ with the given [porenet] flow
  * lines and the extra [porenet] keys of the command line. */
