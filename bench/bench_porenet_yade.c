@@ -52,7 +52,7 @@ static cfg_t *make_cfg(double L, const char *flow, int nextra, char **extra)
                      "z_hi = noslip\n"
                      "[particles]\nsource = none\ndensity = 2600\n"
                      "[contact]\nrestitution = 0.5\ncontact_time = 0.02\nfriction = 0.5\n"
-                     "[dem]\ngravity = 0 0 -9.81\nsteps_per_contact = 20\n"
+                     "[dem]\ngravity = 0 0 -9.81\nsteps_per_contact = 20\nmax_overlap = 0.1\n"
                      "[porenet]\nviscosity = 1\nfluid_density = 1000\nretriangulate = 10\n%s",
                      L, L, L, flow);
     for (int i = 0; i < nextra && k < (int)sizeof text; i++) k += snprintf(text + k, sizeof text - k, "%s\n", extra[i]);
