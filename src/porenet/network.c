@@ -18,6 +18,8 @@
  *   k = w α A R_h²/(μ L)                                           (3.3–3.5)
  * and the force per unit pressure jump on each vertex: sector (3.10) plus its
  * share A γ_k/γ of the viscous force (3.13–3.14) along n = P_i→P_j.
+ * porenet.wall_throats = yade replaces the conductances of the throats lying in
+ * a wall plane by YADE FlowEngine's (wall_throats_yade below).
  */
 #include <math.h>
 #include <stdarg.h>
@@ -82,6 +84,16 @@ static void cross3(const double *a, const double *b, double *c)
     c[2] = a[0] * b[1] - a[1] * b[0];
 }
 static double norm3(const double *a) { return sqrt(dot3(a, a)); }
+
+/* Angle at o of the triangle (o, a, b): the sector ½ r² θ of a sphere centred at o. */
+static double angle_at(const double *o, const double *a, const double *b)
+{
+    double u[3], v[3];
+    sub3(a, o, u);
+    sub3(b, o, v);
+    const double den = norm3(u) * norm3(v);
+    return den > 0 ? acos(fmax(-1.0, fmin(1.0, dot3(u, v) / den))) : 0.5 * M_PI;
+}
 
 /* Solid angle of triangle (a, b, c) seen from o (Van Oosterom & Strackee 1983). */
 static double solid_angle(const double *o, const double *a, const double *b, const double *c)
@@ -192,12 +204,6 @@ static int cmp_pair(const void *a, const void *b)
     return x[0] < y[0] ? -1 : x[0] > y[0] ? 1 : (x[1] > y[1]) - (x[1] < y[1]);
 }
 
-/* ω of sphere centre c through (a, P_i, P_j) */
-static double cone(const double *c, const double *a, const double *Pi, const double *Pj)
-{
-    return solid_angle(c, a, Pi, Pj);
-}
-
 static double yade_wall_conductance(const pn_domain_t *dom, const pn_params_t *prm, const pn_tri_t *t,
                                     const pn_net_t *net, const int *pts, int npts, int common, int slip, int f0)
 {
@@ -223,16 +229,11 @@ static double yade_wall_conductance(const pn_domain_t *dom, const pn_params_t *p
         mh[ax[0]] = pl[0] - 0.5 * (c2[ax[0]] + c3[ax[0]]);
         sub3(c3, c2, e);
         cross3(mh, e, S);
-        const double w2 = cone(c2, A2, Pi, Pj) + cone(c2, c3, Pi, Pj), w3 = cone(c3, A3, Pi, Pj) + cone(c3, c2, Pi, Pj);
+        const double w2 = solid_angle(c2, A2, Pi, Pj) + solid_angle(c2, c3, Pi, Pj);
+        const double w3 = solid_angle(c3, A3, Pi, Pj) + solid_angle(c3, c2, Pi, Pj);
         vsol = (r2 * r2 * r2 * w2 + r3 * r3 * r3 * w3) / 3.0;
         gam = r2 * r2 * w2 + r3 * r3 * w3;
-        double u[3], v[3];
-        sub3(A2, c2, u);
-        sub3(c3, c2, v);
-        sect += 0.5 * r2 * r2 * acos(fmax(-1.0, fmin(1.0, dot3(u, v) / (norm3(u) * norm3(v)))));
-        sub3(A3, c3, u);
-        sub3(c2, c3, v);
-        sect += 0.5 * r3 * r3 * acos(fmax(-1.0, fmin(1.0, dot3(u, v) / (norm3(u) * norm3(v)))));
+        sect = 0.5 * r2 * r2 * angle_at(c2, A2, c3) + 0.5 * r3 * r3 * angle_at(c3, A3, c2);
     } else {
         const double *c = t->x + 3 * pts[0], r = t->r[pts[0]];
         double A[3], B[3], u[3], v[3];
@@ -243,7 +244,7 @@ static double yade_wall_conductance(const pn_domain_t *dom, const pn_params_t *p
         sub3(c, A, u);
         sub3(c, B, v);
         cross3(u, v, S);
-        const double w = cone(c, A, Pi, Pj) + cone(c, B, Pi, Pj);
+        const double w = solid_angle(c, A, Pi, Pj) + solid_angle(c, B, Pi, Pj);
         vsol = r * r * r * w / 3.0;
         gam = r * r * w;
         sect = 0.25 * M_PI * r * r;
@@ -657,12 +658,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
         double nv[3] = {S[0] / Sa, S[1] / Sa, S[2] / Sa};
         double sec[3], secsum = 0;
         for (int v = 0; v < 3; v++) {
-            double a[3], b[3];
-            sub3(c[(v + 1) % 3], c[v], a);
-            sub3(c[(v + 2) % 3], c[v], b);
-            double cs = dot3(a, b) / (norm3(a) * norm3(b));
-            double th = acos(fmax(-1.0, fmin(1.0, cs)));
-            sec[v] = 0.5 * rr[v] * rr[v] * th;
+            sec[v] = 0.5 * rr[v] * rr[v] * angle_at(c[v], c[(v + 1) % 3], c[(v + 2) % 3]);
             secsum += sec[v];
         }
         double Af = Sa - secsum;
