@@ -13,7 +13,8 @@
  * mean of u over the whole box, which by discrete continuity is the flux
  * through any cross-section per unit area — the Darcy flux (solid included:
  * the immersed boundary's own leakage through the spheres is part of its
- * error, and was measured to carry < 1e-4 of the flux).
+ * error; on the packing of cases/permeability_crosscheck it carries < 1e-4
+ * of the flux).
  *
  * Forcing: forcing_time κ_f = 0.2 (docs/theory.md §6b) with the explicit
  * viscous term, whose steady state does not depend on Δt (the packing of
@@ -24,8 +25,9 @@
  *
  * make test: c = 0.216 at D/Δx ≈ 8 and 0.343 at 8 and 12;
  * scripts/permeability_crosscheck.sh (IBM_PERM_FULL=1): c = 0.125 … 0.5236 at
- * D/Δx ≈ 8, 12, 16.
- * RANKS: 2
+ * D/Δx ≈ 8, 12, 16, on 2 ranks (same K to 6 digits as on 1).  One rank
+ * here: 27 s on the shared machine at load 12, 92 s on 2 ranks.
+ * RANKS: 1
  */
 #include "ibmtest.h"
 #include "modules.h"
@@ -36,8 +38,8 @@ static const double zick_homsy[7][2] = {{0.027, 2.008}, {0.064, 2.810}, {0.125, 
                                         {0.343, 15.4},  {0.45, 28.1},   {0.5236, 42.1}};
 
 /* Steady flow through the SC array of solid fraction c with n cells across
- * the box of two periods; returns the measured K, and D/Δx, the permeability
- * ratio κ/κ_ZH = K_ZH/K, the wall time. */
+ * the box of two periods; returns the measured K, with D/Δx and the wall
+ * time. */
 static double sc_array_K(double c, int n, double *dpd, double *wall)
 {
     const double D = 1.0, a = 0.5 * D, nu = 1.0, f = 0.1;
@@ -105,7 +107,7 @@ static double kappa_ratio(int ic, double dpd_target)
  * second dominates in dense arrays, where the gaps are a fraction of a cell
  * (c = 0.343: 0.15 D = 1.2 Δx at D/Δx = 8), and falls fast with Δx.
  *
- * make test (about 20 s on 2 ranks): c = 0.216 at D/Δx ≈ 8, κ within 5 % of
+ * make test (27 s on one rank of the loaded machine): c = 0.216 at D/Δx ≈ 8, κ within 5 % of
  * Zick & Homsy (measured +2.7 %; the dilute array's drag is within 2 % at
  * this resolution, theory §6b); c = 0.343 at D/Δx ≈ 8 and 12, measured
  * +17.3 % and +4.0 %: bound 6 % at 12 and the error at least halved from 8

@@ -18,8 +18,8 @@
 #include <string.h>
 
 #include "config.h"
-#include "io.h"
 #include "dem.h"
+#include "io.h"
 #include "porenet.h"
 #include "sim.h"
 #include "util.h"
@@ -78,16 +78,9 @@ static int read_packing_h5(cfg_t *cfg, const char *path, porenet_part_t *pp)
     return (int)n;
 }
 
-static void read_packing(cfg_t *cfg, porenet_part_t *pp)
+/* A text packing: x y z r per line, # comments. */
+static int read_packing_text(cfg_t *cfg, const char *path, porenet_part_t *pp)
 {
-    const char *path = cfg_string(cfg, "porenet", "packing");
-    size_t len = strlen(path);
-    if ((len > 3 && !strcmp(path + len - 3, ".h5")) || (len > 5 && !strcmp(path + len - 5, ".hdf5"))) {
-        pp->n = read_packing_h5(cfg, path, pp);
-        if (pp->n < 4) cfg_fail(cfg, "porenet", "packing", "%s: %d spheres (at least 4 needed)", path, pp->n);
-        wrap_packing(pp);
-        return;
-    }
     FILE *f = fopen(path, "r");
     if (!f) cfg_fail(cfg, "porenet", "packing", "cannot open %s", path);
     char line[1024];
@@ -110,6 +103,15 @@ static void read_packing(cfg_t *cfg, porenet_part_t *pp)
         n++;
     }
     fclose(f);
+    return n;
+}
+
+static void read_packing(cfg_t *cfg, porenet_part_t *pp)
+{
+    const char *path = cfg_string(cfg, "porenet", "packing");
+    size_t len = strlen(path);
+    int h5 = (len > 3 && !strcmp(path + len - 3, ".h5")) || (len > 5 && !strcmp(path + len - 5, ".hdf5"));
+    int n = h5 ? read_packing_h5(cfg, path, pp) : read_packing_text(cfg, path, pp);
     if (n < 4) cfg_fail(cfg, "porenet", "packing", "%s: %d spheres (at least 4 needed)", path, n);
     pp->n = n;
     wrap_packing(pp);
