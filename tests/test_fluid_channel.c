@@ -255,6 +255,60 @@ static void test_hagen_poiseuille(void **state)
         }
 }
 
+/* Stability with the quadratic wall ghost (docs/theory.md §4.5).  Walls in
+ * y (16 cells, ν/Δy² = 256), x nearly inert (4 cells over 4, ν/Δx² = 1), an
+ * x-uniform field u(y) = (−1)^j: divergence-free and not advected, so only
+ * the viscous term acts, and it holds the wall-localised mode of largest
+ * eigenvalue ν·8/√3·256.  Explicit: the adaptive step at fourier = 0.62 (the
+ * largest accepted) with the wall rows' Gershgorin sum must decay (max |u|
+ * after 100 steps below its start: RK3 factor |R(−2.15)| = 0.49 for that
+ * mode); at the step of the linear-ghost bound 4/Δy² + 4/Δx² the mode grows
+ * by |R(−2.85)| = 1.65 a step, which the test measures (> 10³ after 100
+ * steps) to show that the changed bound is needed.  Crank–Nicolson at
+ * νΔt/Δy² = 10 and 1000 (far beyond any explicit limit): max |u| stays
+ * below its start after 50 steps (one lagged solve per stage would grow by
+ * 1.28 and 4.5 a step there; the two solves are stable). */
+static double stability_run(int impl, double fourier, double dt_fixed, int nsteps)
+{
+    char text[1024];
+    snprintf(text, sizeof text,
+             "[domain]\ngeometry = 2d\nnx = 4\nny = 16\nlength = 4 1 1\n[boundary]\ny_lo = noslip\ny_hi = noslip\n"
+             "[fluid]\nnu = 1\nviscous = %s\nwall_ghost = quadratic\nfourier = %g\ndt = %.17g\n",
+             vname[impl], fourier, dt_fixed);
+    grid_t *g;
+    fluid_t *f = ft_from_case(text, &g);
+    for (int i = 0; i < g->nxl; i++)
+        for (int j = 0; j < g->n[1]; j++) f->u[0][G_IDX(g, i, j, 0)] = j % 2 ? 1.0 : -1.0;
+    fluid_apply_bc(f);
+    for (int s = 0; s < nsteps; s++) fluid_step(f, fluid_stable_dt(f));
+    double m = 0;
+    for (int i = 0; i < g->nxl; i++)
+        for (int j = 0; j < g->n[1]; j++) {
+            double x = fabs(f->u[0][G_IDX(g, i, j, 0)]);
+            m = isfinite(x) ? fmax(m, x) : INFINITY; /* a blow-up ends in NaN, which fmax would drop */
+        }
+    m = grid_max(g, m);
+    fluid_free(f);
+    grid_free(g);
+    return m;
+}
+
+static void test_quadratic_stability(void **state)
+{
+    double a = stability_run(0, 0.62, 0, 100);
+    double b = stability_run(0, 0.62, 0.62 * 4 / (4 * 256.0 + 4 * 1.0), 100);
+    msg("  explicit, quadratic ghost, 100 steps from max |u| = 1: %.2e at the adaptive step (fourier 0.62), %.2e at "
+        "the linear-ghost bound\n",
+        a, b);
+    assert_true(a < 1.0);
+    assert_true(b > 1e3);
+    for (int q = 0; q < 2; q++) {
+        double F = q ? 1000 : 10, c = stability_run(1, 0.5, F / 256, 50);
+        msg("  Crank-Nicolson, quadratic ghost, νΔt/Δy² = %g, 50 steps: max |u| = %.3g\n", F, c);
+        assert_true(c < 1.0);
+    }
+}
+
 /* The stage hook runs three times per step, after the predictor, with
  * dt_stage = (γ_k + ζ_k)Δt summing to Δt (8/15, 2/15, 1/3). */
 static double hook_sum;
@@ -295,6 +349,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_poiseuille_uniform),
         cmocka_unit_test(test_poiseuille_stretched),
         cmocka_unit_test(test_hagen_poiseuille),
+        cmocka_unit_test(test_quadratic_stability),
         cmocka_unit_test(test_stage_hook),
     };
     TEST_MPI_RUN("fluid_channel", tests);

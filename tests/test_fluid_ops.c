@@ -647,10 +647,8 @@ static const char *base_case = "[domain]\ngeometry = %s\nnx = 8\nny = 8\nnz = %d
 
 /* Load a case, build the grid and the fluid and set the initial condition;
  * returns the error message, or "" when everything was accepted. */
-static const char *try_case(const char *geom, const char *boundary, const char *fluid)
+static const char *try_text(const char *text)
 {
-    char text[2048];
-    snprintf(text, sizeof text, base_case, geom, strcmp(geom, "3d") ? 1 : 8, boundary, fluid);
     static cfg_t *cfg;
     static grid_t *g;
     static fluid_t *f;
@@ -676,6 +674,13 @@ static const char *try_case(const char *geom, const char *boundary, const char *
     grid_free(g);
     if (cfg) cfg_free(cfg);
     return last_msg;
+}
+
+static const char *try_case(const char *geom, const char *boundary, const char *fluid)
+{
+    char text[2048];
+    snprintf(text, sizeof text, base_case, geom, strcmp(geom, "3d") ? 1 : 8, boundary, fluid);
+    return try_text(text);
 }
 
 static void expect_error(const char *geom, const char *boundary, const char *fluid, const char *needle)
@@ -711,6 +716,12 @@ static void test_bad_input(void **state)
                  "fluid.init: laminar needs exactly one wall-bounded direction");
     expect_error("2d", "y_lo = noslip\ny_hi = freeslip", "nu = 0.1\ninit = laminar",
                  "fluid.init: laminar needs no-slip walls");
+    expect_error("2d", chan, "nu = 0.1\nwall_ghost = cubic", "case.ini:12: fluid.wall_ghost: 'cubic' is not one of");
+    const char *one = "[domain]\ngeometry = 2d\nnx = 8\nny = 1\nlength = 1 1 1\n[boundary]\ny_lo = noslip\n"
+                      "y_hi = noslip\n[fluid]\nnu = 0.1\nwall_ghost = quadratic\n";
+    const char *m = try_text(one);
+    msg("  [one cell between walls] -> %s\n", m[0] ? m : "(accepted)");
+    assert_non_null(strstr(m, "case.ini:11: fluid.wall_ghost: quadratic needs at least 2 cells"));
 }
 
 int main(int argc, char **argv)
