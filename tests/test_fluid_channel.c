@@ -222,17 +222,19 @@ static void test_poiseuille_stretched(void **state)
  * grid (h = 1/16): u_h = f(1 − r²)/(4ν) + f h²/(16ν) (linear ghost) or
  * f(1 − r²)/(4ν) (quadratic) to round-off; after t = 7R²/ν the slowest
  * Bessel mode (j₀₁² = 5.78) has decayed by e^{−40}.  Stretched radial grid
- * (tanh_high): exact wall shear ν ∂u/∂r = −fR/2, second-order profile. */
+ * (tanh_high): exact wall shear ν ∂u/∂r = −fR/2, second-order profile
+ * (16 → 32 cells, order > 1.8 asserted). */
 static void test_hagen_poiseuille(void **state)
 {
-    /* (viscous, stretched): the stretched grid with Crank–Nicolson only (the
-     * explicit Fourier limit of its 0.018-wide wall cells needs 3·10⁴ steps) */
-    static const int cases[3][2] = {{0, 0}, {1, 0}, {1, 1}};
-    for (int quad = 0; quad < 2; quad++)
-        for (int cs = 0; cs < 3; cs++) {
-            int impl = cases[cs][0], st = cases[cs][1];
+    /* (viscous, stretched, cells): the stretched grid with Crank–Nicolson only
+     * (the explicit Fourier limit of its 0.018-wide wall cells needs 3·10⁴
+     * steps), at 16 and 32 cells for its order */
+    static const int cases[4][3] = {{0, 0, 16}, {1, 0, 16}, {1, 1, 16}, {1, 1, 32}};
+    for (int quad = 0; quad < 2; quad++) {
+        double est[2];
+        for (int cs = 0; cs < 4; cs++) {
+            int impl = cases[cs][0], st = cases[cs][1], nx = cases[cs][2];
             char text[1024];
-            int nx = 16;
             double nu = 1.0, fb = 4.0;
             snprintf(text, sizeof text,
                      "[domain]\ngeometry = axisymmetric\nnx = %d\nny = 4\nlength = 1 0.5 1\nx_stretch = %s\n"
@@ -245,14 +247,18 @@ static void test_hagen_poiseuille(void **state)
             double se, div;
             int steps;
             double e = run_channel(text, &l, 7.0, &se, &div, &steps);
-            msg("  Hagen-Poiseuille, %s r (%s, %s ghost, %d steps): max |u_h − u − shift| = %.2e (u_max = %.2f), "
-                "wall shear error %.2e, div %.1e\n",
-                st ? "stretched" : "uniform", vname[impl], gname[quad], steps, e, fb / (4 * nu), se, div);
+            msg("  Hagen-Poiseuille, %s r, %d cells (%s, %s ghost, %d steps): max |u_h − u − shift| = %.3e (u_max = "
+                "%.2f), wall shear error %.2e, div %.1e\n",
+                st ? "stretched" : "uniform", nx, vname[impl], gname[quad], steps, e, fb / (4 * nu), se, div);
             if (!st) assert_true(e < ft_exact_tol());
-            else assert_true(e < 0.01 * fb / (4 * nu)); /* second order, ~h² of u_max */
+            else est[nx == 32] = e;
             assert_true(se < ft_exact_tol());
             assert_true(div < 1e-12);
         }
+        double o = conv_order(est[0], est[1], 2);
+        msg("  Hagen-Poiseuille, stretched r, %s ghost: order %.2f\n", gname[quad], o);
+        assert_true(o > 1.8);
+    }
 }
 
 /* Stability with the quadratic wall ghost (docs/theory.md §4.5).  Walls in
