@@ -152,7 +152,7 @@ void fluid_project(fluid_t *f)
  * side, evaluated at u^{k−1} (u_prev) for a first solve, then at that
  * solution for a second one.  The steady state satisfies the quadratic
  * discretisation exactly either way; the second solve is for stability: with
- * C lagged once, a stage amplifies the wall modes for νΔt/Δ² ≳ 5 (1-D
+ * C lagged once, a step amplifies the wall modes for νΔt/Δ² > 8.3 (1-D
  * eigenvalue analysis, docs/theory.md §4.3); with two solves (an even number)
  * every νΔt/Δ² is stable. */
 static void helmholtz_component(fluid_t *f, int c, double adt, const double *u_prev)
