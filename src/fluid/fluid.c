@@ -21,7 +21,8 @@ static const cfg_key_t fluid_keys[] = {
     {"fluid", "wall_ghost", CFG_ENUM, "linear", 1, 0, "linear|quadratic",
      "ghost of the wall-tangential velocity at a no-slip wall in the viscous term: linear 2U − u₀ (exact for "
      "Couette flow), or quadratic through U, u₀, u₁ (exact for plane and pipe Poiseuille flow on a uniform grid; "
-     "the explicit viscous step limit is up to 25 % smaller)"},
+     "costs: the explicit viscous step limit is up to 25 % smaller, Crank–Nicolson does two Helmholtz solves per "
+     "stage)"},
     {"fluid", "cfl", CFG_DOUBLE, "0.5", 1e-6, 1.7, NULL,
      "adaptive step: Δt·max Σ_d |u_d|/Δ_d (RK3 with central advection is stable up to √3)"},
     {"fluid", "fourier", CFG_DOUBLE, "0.5", 1e-6, 0.62, NULL,
