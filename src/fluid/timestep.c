@@ -58,16 +58,15 @@ static double viscous_rate(const fluid_t *f)
             if (i == p->nu[0] - 1 && wx[1].on) cd -= wx[1].k0, cw += wx[1].k1;
             rx = fmax(rx, fabs(cw) + fabs(ce) + fabs(cd));
         }
-        double ryz = 0.0;
-        for (int d = 1; d < 3; d++) {
-            double cc = d == 1 ? p->cy : p->cz, rd = 4.0 * cc;
+        /* y, z: the largest row sum over 4 (1/Δ² at a linear-ghost or interior row) */
+        double ceff[3] = {0.0, p->cy, p->cz};
+        for (int d = 1; d < 3; d++)
             for (int s = 0; s < 2; s++) {
                 const wall_quad_t *w = &q->wq[c][d][s];
-                if (w->on) rd = fmax(rd, fabs(-3.0 * cc + w->k0) + fabs(cc + w->k1));
+                double cc = d == 1 ? p->cy : p->cz;
+                if (w->on) ceff[d] = fmax(ceff[d], 0.25 * (fabs(-3.0 * cc + w->k0) + fabs(cc + w->k1)));
             }
-            ryz += rd;
-        }
-        r = fmax(r, rx + ryz);
+        r = fmax(r, rx + 4.0 * (ceff[1] + ceff[2]));
     }
     return 0.25 * r;
 }
