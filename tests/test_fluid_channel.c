@@ -53,7 +53,7 @@ static double lam_fn(int c, const double x[3], double t, const void *ctx)
 {
     (void)t;
     const lam_t *l = ctx;
-    if (c == l->dw) return 0.0;
+    if (c != (l->dw == 0 ? 1 : 0)) return 0.0; /* the flow: along y between x walls, else along x */
     double s = x[l->dw];
     if (l->axi) return l->uhi + l->f * (l->H * l->H - s * s) / (4 * l->nu) + l->shift;
     return l->ulo + (l->uhi - l->ulo) * s / l->H + l->f * s * (l->H - s) / (2 * l->nu) + l->shift;
@@ -77,7 +77,7 @@ static double run_channel(const char *text, const lam_t *l, double t_end, double
     /* wall shear ν ∂u/∂x at the low wall (planar) or the pipe wall, from the
      * first two cells, against ν u'(wall) */
     double se = 0;
-    int c = 1 - l->dw;
+    int c = l->dw == 0 ? 1 : 0;
     if (l->dw == 0) {
         int at_wall = l->axi ? g->right == MPI_PROC_NULL : g->left == MPI_PROC_NULL;
         if (at_wall) {
@@ -100,8 +100,9 @@ static double run_channel(const char *text, const lam_t *l, double t_end, double
     } else {
         if (g->rank == 0) {
             const double *u = f->u[c];
-            double tau = l->nu * wall_gradient(l->quad, l->ulo, u[G_IDX(g, 0, 0, 0)], u[G_IDX(g, 0, 1, 0)],
-                                               0.5 * g->dy, 1.5 * g->dy);
+            double h = l->dw == 1 ? g->dy : g->dz;
+            long m = G_IDX(g, 0, 0, 0), s1 = l->dw == 1 ? g->sy : 1;
+            double tau = l->nu * wall_gradient(l->quad, l->ulo, u[m], u[m + s1], 0.5 * h, 1.5 * h);
             double exact = (l->uhi - l->ulo) * l->nu / l->H + 0.5 * l->f * l->H;
             se = fabs(tau - exact);
         }
@@ -145,34 +146,43 @@ static void test_couette_stretched(void **state)
         }
 }
 
-/* Plane Poiseuille flow, walls in y (uniform, h = 1/16), body force along x,
- * started from the case file's init = laminar (the continuous profile): it
- * must relax to u + f h²/(8ν) (linear ghost) or to u (quadratic ghost),
- * exactly (module statement above). */
+/* Plane Poiseuille flow, walls in y (2-D) or z (3-D), uniform, h = 1/16,
+ * body force along x, started from the case file's init = laminar (the
+ * continuous profile): it must relax to u + f h²/(8ν) (linear ghost) or to u
+ * (quadratic ghost), exactly (module statement above). */
 static void test_poiseuille_uniform(void **state)
 {
-    for (int quad = 0; quad < 2; quad++)
-        for (int impl = 0; impl < 2; impl++) {
-            char text[1024];
-            int ny = 16;
-            double nu = 0.5, fb = 2.0;
-            snprintf(text, sizeof text,
-                     "[domain]\ngeometry = 2d\nnx = 4\nny = %d\nlength = 0.5 1 1\n[boundary]\ny_lo = noslip\n"
-                     "y_hi = noslip\n[fluid]\nnu = %g\nbody_force = %g 0 0\ninit = laminar\nviscous = %s\n"
-                     "wall_ghost = %s\ndt_max = 0.01\n",
-                     ny, nu, fb, vname[impl], gname[quad]);
-            double h = 1.0 / ny;
-            lam_t l = {.dw = 1, .H = 1, .nu = nu, .f = fb, .shift = quad ? 0 : fb * h * h / (8 * nu), .quad = quad};
-            double se, div;
-            int steps;
-            double e = run_channel(text, &l, 8.0, &se, &div, &steps);
-            msg("  plane Poiseuille, uniform (%s, %s ghost, %d steps): max |u_h − u − shift| = %.2e (u_max = %.3f, "
-                "shift %.2e); wall shear error %.2e; div %.1e\n",
-                vname[impl], gname[quad], steps, e, fb / (8 * nu), l.shift, se, div);
-            assert_true(e < ft_exact_tol());
-            assert_true(se < ft_exact_tol());
-            assert_true(div < 1e-12);
-        }
+    for (int dim = 2; dim <= 3; dim++)
+        for (int quad = 0; quad < 2; quad++)
+            for (int impl = 0; impl < 2; impl++) {
+                char text[1024];
+                int n = 16;
+                double nu = 0.5, fb = 2.0;
+                if (dim == 2)
+                    snprintf(text, sizeof text,
+                             "[domain]\ngeometry = 2d\nnx = 4\nny = %d\nlength = 0.5 1 1\n[boundary]\ny_lo = noslip\n"
+                             "y_hi = noslip\n[fluid]\nnu = %g\nbody_force = %g 0 0\ninit = laminar\nviscous = %s\n"
+                             "wall_ghost = %s\ndt_max = 0.01\n",
+                             n, nu, fb, vname[impl], gname[quad]);
+                else
+                    snprintf(text, sizeof text,
+                             "[domain]\ngeometry = 3d\nnx = 4\nny = 4\nnz = %d\nlength = 0.5 0.5 1\n[boundary]\n"
+                             "z_lo = noslip\nz_hi = noslip\n[fluid]\nnu = %g\nbody_force = %g 0 0\ninit = laminar\n"
+                             "viscous = %s\nwall_ghost = %s\ndt_max = 0.01\n",
+                             n, nu, fb, vname[impl], gname[quad]);
+                double h = 1.0 / n;
+                lam_t l = {.dw = dim == 2 ? 1 : 2, .H = 1, .nu = nu, .f = fb, .quad = quad,
+                           .shift = quad ? 0 : fb * h * h / (8 * nu)};
+                double se, div;
+                int steps;
+                double e = run_channel(text, &l, 8.0, &se, &div, &steps);
+                msg("  plane Poiseuille, uniform, walls in %c (%s, %s ghost, %d steps): max |u_h − u − shift| = %.2e "
+                    "(u_max = %.3f, shift %.2e); wall shear error %.2e; div %.1e\n",
+                    "xyz"[l.dw], vname[impl], gname[quad], steps, e, fb / (8 * nu), l.shift, se, div);
+                assert_true(e < ft_exact_tol());
+                assert_true(se < ft_exact_tol());
+                assert_true(div < 1e-12);
+            }
 }
 
 /* Plane Poiseuille on a stretched grid (walls in x, tanh_both): the wall
