@@ -25,8 +25,8 @@
  *
  * make test: c = 0.216 at D/Δx ≈ 8 and 0.343 at 8 and 12;
  * scripts/permeability_crosscheck.sh (IBM_PERM_FULL=1): c = 0.125 … 0.5236 at
- * D/Δx ≈ 8, 12, 16, on 2 ranks (same K to 6 digits as on 1).  One rank
- * here: 27 s on the shared machine at load 12, 92 s on 2 ranks.
+ * D/Δx ≈ 8, 12, 16 (on 2 ranks: the same K to 6 digits as on 1).  One rank
+ * here: 20–27 s on the shared machine, 92 s on 2 ranks at load 12.
  * RANKS: 1
  */
 #include "ibmtest.h"
