@@ -86,7 +86,13 @@ static inline double node_coord(const grid_t *g, int d, int c, int idx)
  * wall or on the axis at the high side is a boundary value (grid.h). */
 static inline int n_unknowns(const grid_t *g, int c, int d) { return g->n[d] - (c == d && !g->periodic[d] ? 1 : 0); }
 
-static inline int wrap(int i, int n) { return ((i % n) + n) % n; }
+/* i modulo n in [0, n) (i is within a few periods of the domain) */
+static inline int wrap(int i, int n)
+{
+    while (i < 0) i += n;
+    while (i >= n) i -= n;
+    return i;
+}
 
 /* First global index whose node coordinate is >= x (non-periodic x). */
 static int lower_index(const grid_t *g, int c, double x)
@@ -306,8 +312,14 @@ static void add_run(void *ctx, int c, int line, long m0, int len, const double r
     run->line = line;
 }
 
+/* Storage order of two runs of a grid line: by first node, then by sphere. */
+static inline int run_after(const ibm_run_t *a, const ibm_run_t *b)
+{
+    return a->m0 > b->m0 || (a->m0 == b->m0 && a->p > b->p);
+}
+
 /* Sort the runs generated in one grid plane into storage order (by grid
- * line, each line's runs by m0, ties in generation order, i.e. by sphere)
+ * line, each line's runs by m0, then by sphere)
  * and append them to the runs, merged into forced nodes: the runs of a
  * line that overlap or touch become one node run, each node once; every
  * sphere run gets the index of its first node (u0).  All of it on the
@@ -320,8 +332,9 @@ static void sort_and_merge_plane(ibm_t *ibm)
     int32_t *head = q->line_head;
     grow((void **)&q->order, &q->cap_order, q->ntmp, sizeof *q->order, "runs");
     grow((void **)&q->runs, &q->cap_runs, q->nruns + q->ntmp, sizeof *q->runs, "runs");
-    /* counting sort by line (stable), then each line's few runs by m0
-     * (insertion sort, stable): order[head[l] .. head[l+1]) */
+    /* counting sort by line, then each line's few runs by m0 and sphere
+     * (insertion sort; the spheres were visited by their run coordinate,
+     * so that the runs come nearly sorted): order[head[l] .. head[l+1]) */
     memset(head, 0, (size_t)(nlines + 1) * sizeof *head);
     for (long ir = 0; ir < q->ntmp; ir++) head[q->tmp[ir].line + 1]++;
     for (long l = 0; l < nlines; l++) head[l + 1] += head[l];
@@ -333,7 +346,7 @@ static void sort_and_merge_plane(ibm_t *ibm)
         int cnt = head[l + 1] - head[l];
         for (int i = 1; i < cnt; i++) {
             int32_t v = o[i], j = i;
-            for (; j > 0 && q->tmp[o[j - 1]].m0 > q->tmp[v].m0; j--) o[j] = o[j - 1];
+            for (; j > 0 && run_after(&q->tmp[o[j - 1]], &q->tmp[v]); j--) o[j] = o[j - 1];
             o[j] = v;
         }
     }
@@ -398,6 +411,17 @@ static void compute_alpha(ibm_t *ibm, long r0, long r1, long n0, long n1)
     for (long j = 0; j < n1 - n0; j++) q->nshared += q->cnt[j] > 1 ? q->cnt[j] : 0;
 }
 
+typedef struct {
+    double z;  /* centre along the run direction */
+    int32_t p;
+} zkey_t;
+
+static int by_run_coordinate(const void *a, const void *b)
+{
+    const zkey_t *i = a, *j = b;
+    return i->z < j->z ? -1 : i->z > j->z ? 1 : (i->p > j->p) - (i->p < j->p);
+}
+
 /* The node lists, plane by plane (component c, local x index i) in
  * storage order: the spheres whose box reaches the plane generate their
  * runs there, which are sorted, merged and given their α, and, while they
@@ -416,9 +440,14 @@ void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
     if (targets) ibm_targets_note(ibm);
     int *box = xcalloc(7 * (size_t)(ibm->n > 0 ? ibm->n : 1), sizeof *box); /* lo[3], hi[3], in the domain */
     int32_t *head = xcalloc((size_t)g->nxl + 1, sizeof *head), *pair = NULL;
+    /* the spheres by their coordinate along the run direction */
+    zkey_t *zord = xcalloc((size_t)(ibm->n > 0 ? ibm->n : 1), sizeof *zord);
+    for (int p = 0; p < ibm->n; p++) zord[p] = (zkey_t){ibm->s[p].xa[q->rdir], p};
+    qsort(zord, (size_t)ibm->n, sizeof *zord, by_run_coordinate);
     long npair = 0, cap_pair = 0;
     for (int c = 0; c < g->dim; c++) {
-        /* the (sphere, unwrapped x index) pairs of each plane of this rank, by sphere */
+        /* the (sphere, unwrapped x index) pairs of each plane of this rank,
+         * the spheres of a plane by their run coordinate */
         memset(head, 0, ((size_t)g->nxl + 1) * sizeof *head);
         npair = 0;
         for (int p = 0; p < ibm->n; p++) {
@@ -432,7 +461,8 @@ void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
         }
         grow((void **)&pair, &cap_pair, 2 * npair, sizeof *pair, "planes");
         for (int i = 0; i < g->nxl; i++) head[i + 1] += head[i];
-        for (int p = 0; p < ibm->n; p++) {
+        for (int o = 0; o < ibm->n; o++) {
+            int p = zord[o].p;
             const int *bx = box + 7 * p;
             if (!bx[6]) continue;
             for (int ii = bx[0]; ii <= bx[3]; ii++) {
@@ -461,6 +491,7 @@ void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
     q->plane_run[g->dim * g->nxl] = q->nruns;
     q->plane_nrun[g->dim * g->nxl] = q->n_nruns;
     free(box);
+    free(zord);
     free(head);
     free(pair);
     q->built = 1;
