@@ -250,37 +250,74 @@ static inline double alpha_at(double R, double band, double retraction, const do
     return alpha_of_t(d / (sigma * lam * M_SQRT2 * h));
 }
 
-/* α of the len nodes of a run (first at offset r0, spacing step along rd)
- * of a sphere of radius R_eff = R − retraction h: the profile of
- * alpha_at() in two loops, the first (square root, divisions) without
- * branches so that the compiler vectorises it, the second the table
- * look-up.  Node k is at r0 + k step and λ takes one division, so the α
- * differ from alpha_at() by round-off; the table is 0 beyond its end, and
- * a node at the centre, where λ is 0/0, takes its end too (α = 1). */
-static void alpha_run(double Reff, const double r0[3], int rd, double step, double h, int len,
-                      double *restrict al)
+/* α of the nodes of consecutive runs of one plane (cell size h), their α
+ * contiguous from al: the profile of alpha_at() for a sphere of radius
+ * R_eff = R − retraction h.  The nodes are gathered in batches of
+ * ALPHA_BATCH (their run coordinate z and their run's constants), so that
+ * the two loops of alpha_batch() run over many nodes at a time, whatever
+ * the length of the runs (about 10 at D/Δx = 10).  Node k of a run is at
+ * z = r0 + k step (for k ≥ 64: (r0 + k0 step) + (k − k0) step, k0 the
+ * multiple of 64 below k) and λ takes one division, so the α differ from
+ * alpha_at() by round-off. */
+enum { ALPHA_BATCH = 256 };
+
+/* The batch: the first loop (square root, divisions) without branches so
+ * that the compiler vectorises it, the second the table look-up; the table
+ * is 0 beyond its end, and a node at the centre, where λ is 0/0, takes its
+ * end too (α = 1). */
+static void alpha_batch(int n, const double *z, const double *p2, const double *pa, const double *reff,
+                        double tscale, double *restrict al)
 {
-    enum { CHUNK = 64 };
-    double x[CHUNK], p2 = 0.0, pa = 0.0, tscale = alpha_scale / (M_SQRT2 * h);
-    for (int d = 0; d < 3; d++)
-        if (d != rd) p2 += r0[d] * r0[d], pa += fabs(r0[d]);
-    for (int k0 = 0; k0 < len; k0 += CHUNK) {
-        int n = len - k0 < CHUNK ? len - k0 : CHUNK;
-        double z0 = r0[rd] + k0 * step;
-        for (int k = 0; k < n; k++) {
-            double z = z0 + k * step, rr = sqrt(p2 + z * z), d = rr - Reff;
-            double lam = (pa + fabs(z)) / rr, sigma = 0.065 * (1.0 - lam * lam) + 0.39;
-            double t = d * tscale / (sigma * lam); /* t of ibm_alpha() times alpha_scale */
-            x[k] = t < -ALPHA_TABLE ? -ALPHA_TABLE : (t > ALPHA_TABLE ? ALPHA_TABLE : t);
-            x[k] = rr > 0.0 ? x[k] : -ALPHA_TABLE;
+    double x[ALPHA_BATCH];
+    for (int k = 0; k < n; k++) {
+        double rr = sqrt(p2[k] + z[k] * z[k]), d = rr - reff[k];
+        double lam = (pa[k] + fabs(z[k])) / rr, sigma = 0.065 * (1.0 - lam * lam) + 0.39;
+        double t = d * tscale / (sigma * lam); /* t of ibm_alpha() times alpha_scale */
+        x[k] = t < -ALPHA_TABLE ? -ALPHA_TABLE : (t > ALPHA_TABLE ? ALPHA_TABLE : t);
+        x[k] = rr > 0.0 ? x[k] : -ALPHA_TABLE;
+    }
+    for (int k = 0; k < n; k++) {
+        double xa = fabs(x[k]);
+        int i = (int)xa;
+        double f = alpha_table[i] + (xa - i) * (alpha_table[i + 1] - alpha_table[i]);
+        al[k] = x[k] < 0.0 ? 1.0 - f : f;
+    }
+}
+
+static void alpha_runs(const ibm_t *ibm, const ibm_run_t *runs, long nr, double h, double *restrict al)
+{
+    const ibm_priv_t *q = ibm_priv(ibm);
+    double z[ALPHA_BATCH], p2[ALPHA_BATCH], pa[ALPHA_BATCH], reff[ALPHA_BATCH];
+    double step = q->rstep, tscale = alpha_scale / (M_SQRT2 * h), retraction = ibm->prm.retraction;
+    int rd = q->rdir, e = 0; /* nodes in the batch */
+    for (long ir = 0; ir < nr; ir++) {
+        const ibm_run_t *run = &runs[ir];
+        double P2 = 0.0, PA = 0.0, R = ibm->s[run->p].radius - retraction * h, z0 = run->r0[rd];
+        for (int d = 0; d < 3; d++)
+            if (d != rd) P2 += run->r0[d] * run->r0[d], PA += fabs(run->r0[d]);
+        if (run->len <= 64 && e + run->len <= ALPHA_BATCH) { /* the common case, without tests */
+            for (int k = 0; k < run->len; k++) {
+                z[e + k] = (z0 + 0 * step) + k * step;
+                p2[e + k] = P2;
+                pa[e + k] = PA;
+                reff[e + k] = R;
+            }
+            e += run->len;
+            continue;
         }
-        for (int k = 0; k < n; k++) {
-            double xa = fabs(x[k]);
-            int i = (int)xa;
-            double f = alpha_table[i] + (xa - i) * (alpha_table[i + 1] - alpha_table[i]);
-            al[k0 + k] = x[k] < 0.0 ? 1.0 - f : f;
+        for (int k = 0; k < run->len; k++) {
+            if (e == ALPHA_BATCH) {
+                alpha_batch(e, z, p2, pa, reff, tscale, al);
+                al += e;
+                e = 0;
+            }
+            z[e] = (z0 + (k & ~63) * step) + (k & 63) * step;
+            p2[e] = P2;
+            pa[e] = PA;
+            reff[e++] = R;
         }
     }
+    if (e) alpha_batch(e, z, p2, pa, reff, tscale, al);
 }
 
 /* Room for need elements of size sz in *ptr (capacity *cap, doubled). */
@@ -380,7 +417,6 @@ static void compute_alpha(ibm_t *ibm, long r0, long r1, long n0, long n1)
 {
     ibm_priv_t *q = ibm_priv(ibm);
     const grid_t *g = ibm->g;
-    double retraction = ibm->prm.retraction;
     long n = 0;
     for (long ir = r0; ir < r1; ir++) n += q->runs[ir].len;
     grow((void **)&q->alpha, &q->cap_alpha, q->nalpha + n, sizeof *q->alpha, "solid fractions");
@@ -395,13 +431,14 @@ static void compute_alpha(ibm_t *ibm, long r0, long r1, long n0, long n1)
     grow((void **)&q->cnt, &q->cap_cnt, n1 - n0, sizeof *q->cnt, "nodes");
     memset(q->node_asum + n0, 0, (size_t)(n1 - n0) * sizeof(double));
     memset(q->cnt, 0, (size_t)(n1 - n0) * sizeof *q->cnt);
+    /* the cell size h is that of the plane */
+    alpha_runs(ibm, q->runs + r0, r1 - r0, q->hcell[q->runs[r0].c][ibm_node_i(g, q->runs[r0].m0)], q->alpha + q->nalpha);
     for (long ir = r0; ir < r1; ir++) {
         ibm_run_t *run = &q->runs[ir];
-        double h = q->hcell[run->c][ibm_node_i(g, run->m0)], *al = q->alpha + q->nalpha;
+        const double *al = q->alpha + q->nalpha;
         double *A = q->node_asum + run->u0;
         int32_t *cnt = q->cnt + (run->u0 - n0);
         run->a0 = (int32_t)q->nalpha;
-        alpha_run(ibm->s[run->p].radius - retraction * h, run->r0, q->rdir, q->rstep, h, run->len, al);
         for (int k = 0; k < run->len; k++) {
             A[k] += al[k];
             cnt[k]++;
