@@ -27,7 +27,12 @@
 
 /* atanh(1 − 2ε) × max_λ σ(λ)λ × √2: beyond this many h from the surface
  * α is exactly 0 or 1.  max σλ = 0.4633 at λ = 1.528. */
-double ibm_band_halfwidth(void) { return atanh(1.0 - 2.0 * IBM_ALPHA_CUT) * 0.46335 * M_SQRT2; }
+double ibm_band_halfwidth(void)
+{
+    static double band = 0.0; /* computed once: it is asked for per sphere and grid plane */
+    if (band == 0.0) band = atanh(1.0 - 2.0 * IBM_ALPHA_CUT) * 0.46335 * M_SQRT2;
+    return band;
+}
 
 /* ½[1 − tanh t] with the cut, tabulated: f(t) for t = d/(σλΔ) in [0, T]
  * (f(−t) = 1 − f(t)), T = atanh(1 − 2ε) where f reaches 0, sampled at
