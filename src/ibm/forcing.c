@@ -379,31 +379,25 @@ void ibm_update_geometry(ibm_t *ibm)
     free(keep);
 }
 
-/* One forcing of every forced node and each sphere's share of the
- * accumulated impulses into q->sum, plane by plane: the passes of
- * force_nodes and sphere_sums (and, with targets, set_targets before them:
- * the targets from the current velocities) on a plane's runs and nodes
- * while they are in cache — the same operations in the same order.  Used
- * for the stage of spheres that move within the step, and for the last
- * forcing of a step in which nothing moves. */
-static void force_by_planes(ibm_t *ibm, double dt, int targets)
+/* The stage of spheres that move within the step (targets from the
+ * velocities of this stage, one forcing, each sphere's share of the
+ * impulses into q->sum), plane by plane: the three passes of set_targets,
+ * force_nodes and sphere_sums on a plane's runs and nodes while they are
+ * in cache — the same operations in the same order. */
+static void force_stage_by_planes(ibm_t *ibm, double dt)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
-    if (targets) {
-        ibm_targets_note(ibm);
-        q->targets_valid = 1;
-        q->imp_fresh = 1;
-    }
-    int first = q->imp_fresh;
+    ibm_targets_note(ibm);
+    q->targets_valid = 1;
     q->imp_fresh = 0;
     ibm_sums_zero(ibm, q->sum, 1, 0);
     for (long k = 0; k < (long)g->dim * g->nxl; k++) {
         long r0 = q->plane_run[k], r1 = q->plane_run[k + 1], i0 = q->plane_nrun[k], i1 = q->plane_nrun[k + 1];
         if (i1 <= i0) continue;
         long n0 = q->nruns_f[i0].n0, n1 = q->nruns_f[i1 - 1].n0 + q->nruns_f[i1 - 1].len;
-        if (targets) ibm_targets_of(ibm, r0, r1, n0, n1);
-        force_node_runs(ibm, dt, first, i0, i1);
+        ibm_targets_of(ibm, r0, r1, n0, n1);
+        force_node_runs(ibm, dt, 1, i0, i1);
         ibm_sums_of(ibm, q->sum, r0, r1, 1, 0);
     }
 }
@@ -424,8 +418,7 @@ void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
     }
     double w0 = wtime();
     if (!q->frozen && ibm->prm.forcing_iterations == 0) {
-        /* targets, forcing and the impulses of the stage in one pass */
-        force_by_planes(ibm, dt_stage, 1);
+        force_stage_by_planes(ibm, dt_stage);
         ibm->wall_forcing += wtime() - w0;
         return;
     }
@@ -434,15 +427,9 @@ void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
         force_nodes(ibm, dt_stage);
         fluid_stage_project(f, dt_stage);
     }
-    if (q->frozen && stage == 2) {
-        /* the last forcing of the step with the impulses of the step (the
-         * projection does not change them; ibm_stage_end adds the momentum) */
-        force_by_planes(ibm, dt_stage, 0);
-    } else {
-        force_nodes(ibm, dt_stage);
-        /* the impulses of the stage, before the solid fraction moves */
-        if (!q->frozen) sphere_sums(ibm, q->sum, 1, 0);
-    }
+    force_nodes(ibm, dt_stage);
+    /* the impulses of the stage, before the solid fraction moves */
+    if (!q->frozen) sphere_sums(ibm, q->sum, 1, 0);
     ibm->wall_forcing += wtime() - w0;
 }
 
@@ -578,7 +565,7 @@ void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx)
         /* nothing moves within the step: one impulse for the whole step */
         if (stage < 2) return;
         double w0 = wtime();
-        sphere_sums(ibm, q->sum, 0, 1); /* the impulses: with the last forcing */
+        sphere_sums(ibm, q->sum, 1, 1);
         reduce_sums(ibm);
         for (int p = 0; p < ibm->n; p++) {
             double J[3], K[3];
