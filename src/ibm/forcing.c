@@ -217,13 +217,21 @@ void ibm_sums_of(ibm_t *ibm, double *sum_all, long r0, long r1, int impulses, in
         double vol = q->vol[c][ibm_node_i(g, run->m0)], z0 = run->r0[rd], rperp[3] = {run->r0[0], run->r0[1], run->r0[2]};
         double j0 = 0, j1 = 0, m0 = 0, m1 = 0;
         rperp[rd] = 0.0;
-        if (impulses)
+        if (impulses && momentum) /* one loop: four independent sums, one load of α */
+            for (int k = 0; k < run->len; k++) {
+                double share = al[k] > 0.0 ? al[k] / A[k] * imp[k] : 0.0, a = al[k] * u[k * st], z = z0 + k * step;
+                j0 += share;
+                j1 += z * share;
+                m0 += a;
+                m1 += z * a;
+            }
+        else if (impulses)
             for (int k = 0; k < run->len; k++) {
                 double share = al[k] > 0.0 ? al[k] / A[k] * imp[k] : 0.0;
                 j0 += share;
                 j1 += (z0 + k * step) * share;
             }
-        if (momentum)
+        else if (momentum)
             for (int k = 0; k < run->len; k++) {
                 double a = al[k] * u[k * st];
                 m0 += a;
