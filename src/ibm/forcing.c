@@ -94,6 +94,7 @@ void ibm_targets_of(ibm_t *ibm, long r0, long r1, long n0, long n1)
     ibm_priv_t *q = ibm_priv(ibm);
     double step = q->rstep;
     int rd = q->rdir;
+    if (n1 <= n0) return; /* (no nodes on this rank: node_target may be NULL) */
     memset(q->node_target + n0, 0, (size_t)(n1 - n0) * sizeof(double));
     for (long ir = r0; ir < r1; ir++) {
         const ibm_run_t *run = &q->runs[ir];

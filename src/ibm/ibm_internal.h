@@ -14,9 +14,9 @@
  * applied), with solid fraction alpha[a0 + q], and is the forced node
  * u0 + q of the merged lists below.  A sphere + band is convex, so a grid
  * line meets it in one segment (two if a periodic face cuts it).  The runs
- * of all spheres are kept in storage order (by grid line, then m0), so
- * that every pass over them streams through the velocity field and the α
- * array instead of jumping from sphere to sphere. */
+ * of all spheres are kept in storage order (by grid line, then m0, then
+ * sphere), so that every pass over them streams through the velocity field
+ * and the α array instead of jumping from sphere to sphere. */
 typedef struct {
     double r0[3];
     int32_t m0;     /* G_IDX of the first node */
