@@ -516,8 +516,6 @@ void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
         head[0] = 0;
         for (int i = 0; i < g->nxl; i++) {
             long r0 = q->nruns, n0 = q->nnodes;
-            q->plane_run[c * g->nxl + i] = r0;
-            q->plane_nrun[c * g->nxl + i] = q->n_nruns;
             q->ntmp = 0;
             for (int k = head[i]; k < head[i + 1]; k++) {
                 b.p = pair[2 * k];
@@ -530,8 +528,6 @@ void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
             if (mom) ibm_sums_of(ibm, mom, r0, q->nruns, 0, 1);
         }
     }
-    q->plane_run[g->dim * g->nxl] = q->nruns;
-    q->plane_nrun[g->dim * g->nxl] = q->n_nruns;
     free(box);
     free(zord);
     free(head);

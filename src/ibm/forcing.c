@@ -124,21 +124,18 @@ static void set_targets(ibm_t *ibm)
     ibm_targets_of(ibm, 0, q->nruns, 0, q->nnodes);
 }
 
-/* One forcing u ← u + β (Ū − u) of the forced nodes of the node runs
- * i0 .. i1−1, the impulse added to node_imp (stored if first). */
-static void force_node_runs(ibm_t *ibm, double dt, int first, long i0, long i1)
+/* One forcing u ← u + β (Ū − u) of every forced node, the impulse added
+ * to node_imp (stored by the first forcing after set_targets). */
+static void force_nodes(ibm_t *ibm, double dt)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
     double kappa = ibm->prm.forcing_time, nu = ibm->f->prm.nu;
     long st = q->rstride;
-    int fast = kappa <= 0 && st == 1;
-    if (i1 <= i0) return;
-    if (first && !fast) {
-        long n0 = q->nruns_f[i0].n0, n1 = q->nruns_f[i1 - 1].n0 + q->nruns_f[i1 - 1].len;
-        memset(q->node_imp + n0, 0, (size_t)(n1 - n0) * sizeof(double));
-    }
-    for (long ir = i0; ir < i1; ir++) {
+    int fast = kappa <= 0 && st == 1, first = q->imp_fresh;
+    q->imp_fresh = 0;
+    if (first && !fast) memset(q->node_imp, 0, (size_t)q->nnodes * sizeof(double));
+    for (long ir = 0; ir < q->n_nruns; ir++) {
         const ibm_node_run_t *nr = &q->nruns_f[ir];
         double *u = ibm->f->u[nr->c] + nr->m0, *J = q->node_imp + nr->n0;
         const double *A = q->node_asum + nr->n0, *T = q->node_target + nr->n0;
@@ -172,16 +169,6 @@ static void force_node_runs(ibm_t *ibm, double dt, int first, long i0, long i1)
             }
         }
     }
-}
-
-/* One forcing of every forced node (the first after set_targets stores
- * the impulses, the next ones add to them). */
-static void force_nodes(ibm_t *ibm, double dt)
-{
-    ibm_priv_t *q = ibm_priv(ibm);
-    int first = q->imp_fresh;
-    q->imp_fresh = 0;
-    force_node_runs(ibm, dt, first, 0, q->n_nruns);
 }
 
 /* Per-sphere sums over the runs (in storage order, each sphere's sums
@@ -388,29 +375,6 @@ void ibm_update_geometry(ibm_t *ibm)
     free(keep);
 }
 
-/* The stage of spheres that move within the step (targets from the
- * velocities of this stage, one forcing, each sphere's share of the
- * impulses into q->sum), plane by plane: the three passes of set_targets,
- * force_nodes and sphere_sums on a plane's runs and nodes while they are
- * in cache — the same operations in the same order. */
-static void force_stage_by_planes(ibm_t *ibm, double dt)
-{
-    const grid_t *g = ibm->g;
-    ibm_priv_t *q = ibm_priv(ibm);
-    ibm_targets_note(ibm);
-    q->targets_valid = 1;
-    q->imp_fresh = 0;
-    ibm_sums_zero(ibm, q->sum, 1, 0);
-    for (long k = 0; k < (long)g->dim * g->nxl; k++) {
-        long r0 = q->plane_run[k], r1 = q->plane_run[k + 1], i0 = q->plane_nrun[k], i1 = q->plane_nrun[k + 1];
-        if (i1 <= i0) continue;
-        long n0 = q->nruns_f[i0].n0, n1 = q->nruns_f[i1 - 1].n0 + q->nruns_f[i1 - 1].len;
-        ibm_targets_of(ibm, r0, r1, n0, n1);
-        force_node_runs(ibm, dt, 1, i0, i1);
-        ibm_sums_of(ibm, q->sum, r0, r1, 1, 0);
-    }
-}
-
 void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
 {
     ibm_t *ibm = ctx;
@@ -426,11 +390,6 @@ void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
         ibm->wall_alpha += wtime() - w0;
     }
     double w0 = wtime();
-    if (!q->frozen && ibm->prm.forcing_iterations == 0) {
-        force_stage_by_planes(ibm, dt_stage);
-        ibm->wall_forcing += wtime() - w0;
-        return;
-    }
     if (stage == 0 || !q->frozen) set_targets(ibm);
     for (int it = 0; it < ibm->prm.forcing_iterations; it++) {
         force_nodes(ibm, dt_stage);

@@ -202,8 +202,6 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
     }
     size_t nn = (size_t)(n > 0 ? n : 1);
     q->line_head = xcalloc((size_t)(g->dim == 3 ? g->n[1] : 1) + 1, sizeof(int32_t));
-    q->plane_run = xcalloc((size_t)g->dim * (size_t)g->nxl + 1, sizeof(long));
-    q->plane_nrun = xcalloc((size_t)g->dim * (size_t)g->nxl + 1, sizeof(long));
     q->rdir = g->dim == 3 ? 2 : 1;
     q->rstride = g->dim == 3 ? 1 : g->sy;
     q->rstep = g->dim == 3 ? g->dz : g->dy;
@@ -243,8 +241,6 @@ void ibm_free(ibm_t *ibm)
     free(q->node_target);
     free(q->node_imp);
     free(q->line_head);
-    free(q->plane_run);
-    free(q->plane_nrun);
     free(q->order);
     free(q->tmp);
     free(q->cnt);

@@ -46,12 +46,9 @@ typedef struct {
 enum { IBM_FIMP = 0, IBM_TIMP = 3, IBM_MOM = 6, IBM_ANG = 9, IBM_NSUM = 12 };
 
 typedef struct {
-    /* runs of all spheres in storage order, by grid plane (component c,
-     * local x index i): plane k = c·nxl + i holds the runs
-     * plane_run[k] .. plane_run[k+1]−1 and the node runs plane_nrun[k] .. */
+    /* runs of all spheres in storage order */
     ibm_run_t *runs;
     long nruns, cap_runs;
-    long *plane_run, *plane_nrun; /* dim·nxl + 1 */
     double *alpha;
     long nalpha, cap_alpha, nshared; /* nshared: entries at nodes that another sphere's band reaches */
     int rdir;          /* run direction (2 in 3-D, 1 in 2-D), its stride and spacing */
