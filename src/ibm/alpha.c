@@ -302,7 +302,7 @@ static void alpha_runs(const ibm_t *ibm, const ibm_run_t *runs, long nr, double 
             if (d != rd) P2 += run->r0[d] * run->r0[d], PA += fabs(run->r0[d]);
         if (run->len <= 64 && e + run->len <= ALPHA_BATCH) { /* the common case, without tests */
             for (int k = 0; k < run->len; k++) {
-                z[e + k] = (z0 + 0 * step) + k * step;
+                z[e + k] = (z0 + 0 * step) + k * step; /* the formula below at k < 64 */
                 p2[e + k] = P2;
                 pa[e + k] = PA;
                 reff[e + k] = R;
