@@ -17,7 +17,8 @@
  * The immersed boundary's own timers (ibm->wall_*) give its cost, and the
  * difference of the step times with and without spheres checks them.
  *
- * usage: bench_ibm [N=128] [count=1000] [dpd=10] [steps=5] [explicit|implicit]
+ * usage: bench_ibm [N=128] [count=1000] [dpd=10] [steps=5] [explicit|implicit] [variant]
+ * (variant: run only that one, e.g. for a profile)
  * prints, per variant: the fluid step with the spheres, the immersed
  * boundary's time per step (α, forcing, integrals), its fraction of the
  * fluid step alone, node entries per sphere; and one ibm_result line each.
@@ -61,6 +62,7 @@ int main(int argc, char **argv)
     double dpd = argc > 3 ? atof(argv[3]) : 10;
     int steps = argc > 4 ? atoi(argv[4]) : 5;
     int implicit = argc > 5 && !strcmp(argv[5], "implicit");
+    const char *only = argc > 6 ? argv[6] : NULL;
 
     double dx = 1.0 / dpd, L = N * dx;
     int n[3] = {N, N, N};
@@ -122,6 +124,7 @@ int main(int argc, char **argv)
         {"free", "free spheres (rho_p/rho = 2 under gravity, alpha rebuilt at every stage)", IBM_FREE, 0},
     };
     for (int v = 0; v < 3; v++) {
+        if (only && strcmp(only, variant[v].name)) continue;
         for (int p = 0; p < count; p++) {
             s[p].kind = variant[v].kind;
             memset(s[p].u, 0, sizeof s[p].u);

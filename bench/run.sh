@@ -26,7 +26,7 @@ run() {
     echo "=== $name: $*"
     local log=$OUT/$name.log
     if "$@" >"$log" 2>&1; then cat "$log"; else cat "$log"; echo "!!! $name failed"; status=1; fi
-    grep -E '^(bench_|RESULT|BENCH|walls |periodic |channel |ibm_|#? +[0-9]+ )' "$log" | sed "s/^/[$name] /" >>"$RES"
+    grep -E '^(bench_|RESULT|BENCH|walls |periodic |channel |ibm_|#? +[0-9]+ |#   N = [0-9]+:)' "$log" | sed "s/^/[$name] /" >>"$RES"
 }
 
 if want fluid; then
@@ -43,7 +43,11 @@ if want multigrid; then
     for np in 1 2; do run multigrid_np$np $MPIRUN -np $np "$BUILD/bench/bench_mg" "$N"; done
 fi
 if want porenet && [ -x "$BUILD/bench/bench_porenet" ]; then
-    run porenet $MPIRUN -np 1 "$BUILD/bench/bench_porenet" 5000 20000
+    run porenet $MPIRUN -np 1 "$BUILD/bench/bench_porenet" 5000 20000 80000
+    # against YADE's FlowEngine on the same packings (installs yade)
+    run porenet_yade bash bench/porenet_vs_yade.sh
+    [ -f "$BUILD/bench_porenet_yade/porenet_yade.md" ] &&
+        sed 's/^/[porenet_yade] /' "$BUILD/bench_porenet_yade/porenet_yade.md" >>"$RES"
 fi
 if want ibm && [ -x "$BUILD/bench/bench_ibm" ]; then
     for np in 1 2; do run ibm_np$np $MPIRUN -np $np "$BUILD/bench/bench_ibm"; done

@@ -81,9 +81,18 @@ void pn_tri_point(const pn_domain_t *dom, const pn_tri_t *t, const double *x, in
 
 /* ---- pore network (network.c) ------------------------------------------------- */
 
+/* Conductance of the throats lying in a wall plane (between two pores on the
+ * same wall; docs/theory.md "Pore network", wall throats). */
+typedef enum {
+    PN_WALL_MIRROR = 0, /* each facet of the mirrored set its own throat, weight ½ per plane: exact symmetry */
+    PN_WALL_YADE        /* YADE FlowEngine (slipBoundary): the facets between two wall pores merged into one
+                           throat (the in-box half of the mirrored set), R_h × 2^(-1/4) per slip wall plane */
+} pn_wall_model_t;
+
 typedef struct {
     double alpha;     /* conductance factor α (thesis: ½) */
     double mu;        /* dynamic viscosity (Pa s) */
+    pn_wall_model_t wall_model;
 } pn_params_t;
 
 typedef struct {

@@ -27,7 +27,12 @@
 
 /* atanh(1 − 2ε) × max_λ σ(λ)λ × √2: beyond this many h from the surface
  * α is exactly 0 or 1.  max σλ = 0.4633 at λ = 1.528. */
-double ibm_band_halfwidth(void) { return atanh(1.0 - 2.0 * IBM_ALPHA_CUT) * 0.46335 * M_SQRT2; }
+double ibm_band_halfwidth(void)
+{
+    static double band = 0.0; /* computed once: it is asked for per sphere and grid plane */
+    if (band == 0.0) band = atanh(1.0 - 2.0 * IBM_ALPHA_CUT) * 0.46335 * M_SQRT2;
+    return band;
+}
 
 /* ½[1 − tanh t] with the cut, tabulated: f(t) for t = d/(σλΔ) in [0, T]
  * (f(−t) = 1 − f(t)), T = atanh(1 − 2ε) where f reaches 0, sampled at
@@ -86,7 +91,13 @@ static inline double node_coord(const grid_t *g, int d, int c, int idx)
  * wall or on the axis at the high side is a boundary value (grid.h). */
 static inline int n_unknowns(const grid_t *g, int c, int d) { return g->n[d] - (c == d && !g->periodic[d] ? 1 : 0); }
 
-static inline int wrap(int i, int n) { return ((i % n) + n) % n; }
+/* i modulo n in [0, n) (i is within a few periods of the domain) */
+static inline int wrap(int i, int n)
+{
+    while (i < 0) i += n;
+    while (i >= n) i -= n;
+    return i;
+}
 
 /* First global index whose node coordinate is >= x (non-periodic x). */
 static int lower_index(const grid_t *g, int c, double x)
@@ -161,58 +172,64 @@ static int sphere_box(const ibm_t *ibm, const ibm_sphere_t *s, int c, int lo[3],
 
 /* A segment of nodes along the run direction: storage index m0 of the
  * first, count len, offset r0 of the first from the sphere's centre, cell
- * size h. */
-typedef void (*seg_fn_t)(void *ctx, int c, long m0, int len, const double r0[3], double h);
+ * size h, on grid line `line` of its plane (the y index in 3-D, 0 in 2-D). */
+typedef void (*seg_fn_t)(void *ctx, int c, int line, long m0, int len, const double r0[3], double h);
 
 /* Visit the segments of the nodes of component c (−1: cell centres) of
- * sphere s on this rank that lie within R_eff + band h of its centre
- * (R_eff = R − retraction h): the grid lines along the run direction (z in
- * 3-D, y in 2-D) through its box, each cut to the chord of that ball and
- * split where a periodic face crosses it.  The cost is that of the nodes
- * returned plus one test per grid line of the box. */
-static void for_sphere_segments(const ibm_t *ibm, const ibm_sphere_t *s, int c, seg_fn_t fn, void *ctx)
+ * sphere s (box lo..hi from sphere_box) in the grid plane of unwrapped x
+ * index ii, if that plane is on this rank, that lie within R_eff + band h
+ * of its centre (R_eff = R − retraction h): the grid lines along the run
+ * direction (z in 3-D, y in 2-D) through the box, in storage order, each
+ * cut to the chord of that ball and split where a periodic face crosses
+ * it.  The cost is that of the nodes returned plus one test per grid line
+ * of the box. */
+static void plane_segments(const ibm_t *ibm, const ibm_sphere_t *s, int c, int ii, const int lo[3], const int hi[3],
+                           seg_fn_t fn, void *ctx)
 {
     const grid_t *g = ibm->g;
-    int lo[3], hi[3];
-    if (!sphere_box(ibm, s, c, lo, hi)) return;
     int three = g->dim == 3, rd = three ? 2 : 1;
     int nr = g->n[rd];
     double hr = three ? g->dz : g->dy, offr = c == rd ? 1.0 : 0.5, band = ibm_band_halfwidth();
     int jlo = three ? lo[1] : 0, jhi = three ? hi[1] : 0;
-    for (int ii = lo[0]; ii <= hi[0]; ii++) {
-        int iw = g->periodic[0] ? wrap(ii, g->n[0]) : ii;
-        int il = iw - g->ix0;
-        if (il < 0 || il >= g->nxl) continue;
-        double r[3] = {0, 0, 0};
-        r[0] = node_coord(g, 0, c, iw) + (ii - iw) / g->n[0] * g->L[0] - s->xa[0];
-        double hx = c == 0 ? g->dxc[il] : g->dxf[il];
-        double h = three ? cbrt(hx * g->dy * g->dz) : sqrt(hx * g->dy);
-        double Rout = s->radius + (band - ibm->prm.retraction) * h;
-        for (int jj = jlo; jj <= jhi; jj++) {
-            int jw = 0;
-            double perp2 = r[0] * r[0];
-            if (three) {
-                jw = g->periodic[1] ? wrap(jj, g->n[1]) : jj;
-                r[1] = node_coord(g, 1, c, jw) + (jj - jw) / g->n[1] * g->L[1] - s->xa[1];
-                perp2 += r[1] * r[1];
-            }
-            if (perp2 >= Rout * Rout) continue;
-            /* the chord |r_run| < √(R_out² − r_perp²), within the box */
-            double half = sqrt(Rout * Rout - perp2), xs = s->xa[rd] - g->x0[rd];
-            int a = (int)ceil((xs - half) / hr - offr), b = (int)floor((xs + half) / hr - offr);
-            if (a < lo[rd]) a = lo[rd];
-            if (b > hi[rd]) b = hi[rd];
-            while (a <= b) {
-                /* one segment: up to the next periodic face */
-                int aw = g->periodic[rd] ? wrap(a, nr) : a, len = b - a + 1;
-                if (g->periodic[rd] && aw + len > nr) len = nr - aw;
-                r[rd] = g->x0[rd] + (a + offr) * hr - s->xa[rd];
-                long m0 = three ? G_IDX(g, il, jw, aw) : G_IDX(g, il, aw, 0);
-                fn(ctx, c, m0, len, r, h);
-                a += len;
-            }
+    int iw = g->periodic[0] ? wrap(ii, g->n[0]) : ii;
+    int il = iw - g->ix0;
+    if (il < 0 || il >= g->nxl) return;
+    double r[3] = {0, 0, 0};
+    r[0] = node_coord(g, 0, c, iw) + (ii - iw) / g->n[0] * g->L[0] - s->xa[0];
+    double hx = c == 0 ? g->dxc[il] : g->dxf[il];
+    double h = three ? cbrt(hx * g->dy * g->dz) : sqrt(hx * g->dy);
+    double Rout = s->radius + (band - ibm->prm.retraction) * h;
+    int jw = three && g->periodic[1] ? wrap(jlo, g->n[1]) : jlo; /* wrapped jj, carried along */
+    for (int jj = jlo; jj <= jhi; jj++, jw = three && g->periodic[1] && jw == g->n[1] - 1 ? 0 : jw + 1) {
+        double perp2 = r[0] * r[0];
+        if (three) {
+            r[1] = node_coord(g, 1, c, jw) + (jj - jw) / g->n[1] * g->L[1] - s->xa[1];
+            perp2 += r[1] * r[1];
+        }
+        if (perp2 >= Rout * Rout) continue;
+        /* the chord |r_run| < √(R_out² − r_perp²), within the box */
+        double half = sqrt(Rout * Rout - perp2), xs = s->xa[rd] - g->x0[rd];
+        int a = (int)ceil((xs - half) / hr - offr), b = (int)floor((xs + half) / hr - offr);
+        if (a < lo[rd]) a = lo[rd];
+        if (b > hi[rd]) b = hi[rd];
+        while (a <= b) {
+            /* one segment: up to the next periodic face */
+            int aw = g->periodic[rd] ? wrap(a, nr) : a, len = b - a + 1;
+            if (g->periodic[rd] && aw + len > nr) len = nr - aw;
+            r[rd] = g->x0[rd] + (a + offr) * hr - s->xa[rd];
+            long m0 = three ? G_IDX(g, il, jw, aw) : G_IDX(g, il, aw, 0);
+            fn(ctx, c, three ? jw : 0, m0, len, r, h);
+            a += len;
         }
     }
+}
+
+/* The same for all the planes of the box of sphere s. */
+static void for_sphere_segments(const ibm_t *ibm, const ibm_sphere_t *s, int c, seg_fn_t fn, void *ctx)
+{
+    int lo[3], hi[3];
+    if (!sphere_box(ibm, s, c, lo, hi)) return;
+    for (int ii = lo[0]; ii <= hi[0]; ii++) plane_segments(ibm, s, c, ii, lo, hi, fn, ctx);
 }
 
 /* ---- node runs ------------------------------------------------------------------ */
@@ -238,121 +255,156 @@ static inline double alpha_at(double R, double band, double retraction, const do
     return alpha_of_t(d / (sigma * lam * M_SQRT2 * h));
 }
 
-/* α of the len nodes of a run (first at offset r0, spacing step along rd)
- * of a sphere of radius R_eff = R − retraction h: the profile of
- * alpha_at() in two loops, the first (square root, divisions) without
- * branches so that the compiler vectorises it, the second the table
- * look-up.  Node k is at r0 + k step and λ takes one division, so the α
- * differ from alpha_at() by round-off; the table is 0 beyond its end, and
- * a node at the centre, where λ is 0/0, takes its end too (α = 1). */
-static void alpha_run(double Reff, const double r0[3], int rd, double step, double h, int len,
-                      double *restrict al)
+/* α of the nodes of consecutive runs of one plane (cell size h), their α
+ * contiguous from al: the profile of alpha_at() for a sphere of radius
+ * R_eff = R − retraction h.  The nodes are gathered in batches of
+ * ALPHA_BATCH (their run coordinate z and their run's constants), so that
+ * the two loops of alpha_batch() run over many nodes at a time, whatever
+ * the length of the runs (about 10 at D/Δx = 10).  Node k of a run is at
+ * z = r0 + k step (for k ≥ 64: (r0 + k0 step) + (k − k0) step, k0 the
+ * multiple of 64 below k) and λ takes one division, so the α differ from
+ * alpha_at() by round-off. */
+enum { ALPHA_BATCH = 256 };
+
+/* The batch: the first loop (square root, divisions) without branches so
+ * that the compiler vectorises it, the second the table look-up; the table
+ * is 0 beyond its end, and a node at the centre, where λ is 0/0, takes its
+ * end too (α = 1). */
+static void alpha_batch(int n, const double *z, const double *p2, const double *pa, const double *reff,
+                        double tscale, double *restrict al)
 {
-    enum { CHUNK = 64 };
-    double x[CHUNK], p2 = 0.0, pa = 0.0, tscale = alpha_scale / (M_SQRT2 * h);
-    for (int d = 0; d < 3; d++)
-        if (d != rd) p2 += r0[d] * r0[d], pa += fabs(r0[d]);
-    for (int k0 = 0; k0 < len; k0 += CHUNK) {
-        int n = len - k0 < CHUNK ? len - k0 : CHUNK;
-        double z0 = r0[rd] + k0 * step;
-        for (int k = 0; k < n; k++) {
-            double z = z0 + k * step, rr = sqrt(p2 + z * z), d = rr - Reff;
-            double lam = (pa + fabs(z)) / rr, sigma = 0.065 * (1.0 - lam * lam) + 0.39;
-            double t = d * tscale / (sigma * lam); /* t of ibm_alpha() times alpha_scale */
-            x[k] = t < -ALPHA_TABLE ? -ALPHA_TABLE : (t > ALPHA_TABLE ? ALPHA_TABLE : t);
-            x[k] = rr > 0.0 ? x[k] : -ALPHA_TABLE;
-        }
-        for (int k = 0; k < n; k++) {
-            double xa = fabs(x[k]);
-            int i = (int)xa;
-            double f = alpha_table[i] + (xa - i) * (alpha_table[i + 1] - alpha_table[i]);
-            al[k0 + k] = x[k] < 0.0 ? 1.0 - f : f;
-        }
+    double x[ALPHA_BATCH];
+    for (int k = 0; k < n; k++) {
+        double rr = sqrt(p2[k] + z[k] * z[k]), d = rr - reff[k];
+        double lam = (pa[k] + fabs(z[k])) / rr, sigma = 0.065 * (1.0 - lam * lam) + 0.39;
+        double t = d * tscale / (sigma * lam); /* t of ibm_alpha() times alpha_scale */
+        x[k] = t < -ALPHA_TABLE ? -ALPHA_TABLE : (t > ALPHA_TABLE ? ALPHA_TABLE : t);
+        x[k] = rr > 0.0 ? x[k] : -ALPHA_TABLE;
+    }
+    for (int k = 0; k < n; k++) {
+        double xa = fabs(x[k]);
+        int i = (int)xa;
+        double f = alpha_table[i] + (xa - i) * (alpha_table[i + 1] - alpha_table[i]);
+        al[k] = x[k] < 0.0 ? 1.0 - f : f;
     }
 }
 
-/* Grid line of a run: (component, local x index[, global y index]). */
-static inline int32_t run_line(const grid_t *g, int c, long m0)
+static void alpha_runs(const ibm_t *ibm, const ibm_run_t *runs, long nr, double h, double *restrict al)
 {
-    int il = ibm_node_i(g, m0);
-    if (g->dim == 2) return (int32_t)(c * g->nxl + il);
-    int jw = (int)((m0 - G_IDX(g, il, 0, 0)) / g->sy);
-    return (int32_t)(((long)c * g->nxl + il) * g->n[1] + jw);
+    const ibm_priv_t *q = ibm_priv(ibm);
+    double z[ALPHA_BATCH], p2[ALPHA_BATCH], pa[ALPHA_BATCH], reff[ALPHA_BATCH];
+    double step = q->rstep, tscale = alpha_scale / (M_SQRT2 * h), retraction = ibm->prm.retraction;
+    int rd = q->rdir, e = 0; /* nodes in the batch */
+    for (long ir = 0; ir < nr; ir++) {
+        const ibm_run_t *run = &runs[ir];
+        double P2 = 0.0, PA = 0.0, R = ibm->s[run->p].radius - retraction * h, z0 = run->r0[rd];
+        for (int d = 0; d < 3; d++)
+            if (d != rd) P2 += run->r0[d] * run->r0[d], PA += fabs(run->r0[d]);
+        if (run->len <= 64 && e + run->len <= ALPHA_BATCH) { /* the common case, without tests */
+            for (int k = 0; k < run->len; k++) {
+                z[e + k] = (z0 + 0 * step) + k * step; /* the formula below at k < 64 */
+                p2[e + k] = P2;
+                pa[e + k] = PA;
+                reff[e + k] = R;
+            }
+            e += run->len;
+            continue;
+        }
+        for (int k = 0; k < run->len; k++) {
+            if (e == ALPHA_BATCH) {
+                alpha_batch(e, z, p2, pa, reff, tscale, al);
+                al += e;
+                e = 0;
+            }
+            z[e] = (z0 + (k & ~63) * step) + (k & 63) * step;
+            p2[e] = P2;
+            pa[e] = PA;
+            reff[e++] = R;
+        }
+    }
+    if (e) alpha_batch(e, z, p2, pa, reff, tscale, al);
 }
 
-/* Record a run of sphere b->p (its α comes later, in storage order). */
-static void add_run(void *ctx, int c, long m0, int len, const double r0[3], double h)
+/* Room for need elements of size sz in *ptr (capacity *cap, doubled). */
+static void grow(void **ptr, long *cap, long need, size_t sz, const char *what)
+{
+    if (need <= *cap && *ptr) return;
+    long c = *cap > 0 ? *cap : 1024;
+    while (c < need) c *= 2;
+    void *p = realloc(*ptr, (size_t)c * sz);
+    if (!p) die_local("immersed boundary: out of memory for %ld %s", c, what);
+    *ptr = p;
+    *cap = c;
+}
+
+/* Record a run of sphere b->p in the plane's scratch (sorted, merged and
+ * given its α with the rest of the plane). */
+static void add_run(void *ctx, int c, int line, long m0, int len, const double r0[3], double h)
 {
     (void)h; /* = hcell[c][i] */
     build_ctx_t *b = ctx;
     ibm_priv_t *q = b->q;
-    if (q->nruns == q->cap_runs) {
-        q->cap_runs = q->cap_runs ? 2 * q->cap_runs : 1024;
-        q->runs_tmp = realloc(q->runs_tmp, (size_t)q->cap_runs * sizeof *q->runs_tmp);
-        if (!q->runs_tmp) die_local("immersed boundary: out of memory for %ld runs", q->cap_runs);
-    }
-    ibm_run_t *run = &q->runs_tmp[q->nruns++];
+    grow((void **)&q->tmp, &q->cap_tmp, q->ntmp + 1, sizeof *q->tmp, "runs");
+    ibm_run_t *run = &q->tmp[q->ntmp++];
     memcpy(run->r0, r0, sizeof run->r0);
     run->m0 = (int32_t)m0;
     run->len = (int16_t)len;
     run->c = (uint8_t)c;
     run->p = b->p;
-    run->line = run_line(b->ibm->g, c, m0);
+    run->line = line;
 }
 
-/* Sort the generated runs into storage order (by grid line, each line's
- * runs by m0, ties in generation order) and merge them into the
- * forced nodes: the runs of a line that overlap or touch become one node
- * run, each node once; every sphere run gets the index of its first node
- * (u0). */
-static void sort_and_merge_runs(ibm_t *ibm)
+/* Storage order of two runs of a grid line: by first node, then by sphere. */
+static inline int run_after(const ibm_run_t *a, const ibm_run_t *b)
+{
+    return a->m0 > b->m0 || (a->m0 == b->m0 && a->p > b->p);
+}
+
+/* Sort the runs generated in one grid plane into storage order (by grid
+ * line, each line's runs by m0, then by sphere)
+ * and append them to the runs, merged into forced nodes: the runs of a
+ * line that overlap or touch become one node run, each node once; every
+ * sphere run gets the index of its first node (u0).  All of it on the
+ * plane's few thousand runs, in cache. */
+static void sort_and_merge_plane(ibm_t *ibm)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
-    long st = q->rstride, nlines = (long)g->dim * g->nxl * (g->dim == 3 ? g->n[1] : 1);
-    if (q->nruns > q->cap_next || !q->runs) { /* (allocated even when empty: memset of NULL is undefined) */
-        q->cap_next = q->cap_runs;
-        free(q->run_order);
-        free(q->runs);
-        q->run_order = xcalloc((size_t)q->cap_next, sizeof *q->run_order);
-        q->runs = xcalloc((size_t)q->cap_next, sizeof *q->runs);
-    }
-    /* counting sort by line (stable), then each line's few runs by m0
-     * (insertion sort, stable): run_order[line_head[l] .. line_head[l+1]) */
-    memset(q->line_head, 0, (size_t)(nlines + 1) * sizeof *q->line_head);
-    for (long ir = 0; ir < q->nruns; ir++) q->line_head[q->runs_tmp[ir].line + 1]++;
-    for (long l = 0; l < nlines; l++) q->line_head[l + 1] += q->line_head[l];
-    for (long ir = 0; ir < q->nruns; ir++) q->run_order[q->line_head[q->runs_tmp[ir].line]++] = (int32_t)ir;
-    for (long l = nlines; l > 0; l--) q->line_head[l] = q->line_head[l - 1];
-    q->line_head[0] = 0;
+    long st = q->rstride, nlines = g->dim == 3 ? g->n[1] : 1;
+    int32_t *head = q->line_head;
+    grow((void **)&q->order, &q->cap_order, q->ntmp, sizeof *q->order, "runs");
+    grow((void **)&q->runs, &q->cap_runs, q->nruns + q->ntmp, sizeof *q->runs, "runs");
+    /* counting sort by line, then each line's few runs by m0 and sphere
+     * (insertion sort; the spheres were visited by their run coordinate,
+     * so that the runs come nearly sorted): order[head[l] .. head[l+1]) */
+    memset(head, 0, (size_t)(nlines + 1) * sizeof *head);
+    for (long ir = 0; ir < q->ntmp; ir++) head[q->tmp[ir].line + 1]++;
+    for (long l = 0; l < nlines; l++) head[l + 1] += head[l];
+    for (long ir = 0; ir < q->ntmp; ir++) q->order[head[q->tmp[ir].line]++] = (int32_t)ir;
+    for (long l = nlines; l > 0; l--) head[l] = head[l - 1];
+    head[0] = 0;
     for (long l = 0; l < nlines; l++) {
-        int32_t *o = q->run_order + q->line_head[l];
-        int cnt = q->line_head[l + 1] - q->line_head[l];
+        int32_t *o = q->order + head[l];
+        int cnt = head[l + 1] - head[l];
         for (int i = 1; i < cnt; i++) {
             int32_t v = o[i], j = i;
-            for (; j > 0 && q->runs_tmp[o[j - 1]].m0 > q->runs_tmp[v].m0; j--) o[j] = o[j - 1];
+            for (; j > 0 && run_after(&q->tmp[o[j - 1]], &q->tmp[v]); j--) o[j] = o[j - 1];
             o[j] = v;
         }
     }
-    long nr = 0;
-    q->n_nruns = 0;
-    q->nnodes = 0;
+    long nr = q->nruns;
     for (long l = 0; l < nlines; l++) {
-        int32_t e = q->line_head[l], end = q->line_head[l + 1];
+        int32_t e = head[l], end = head[l + 1];
         while (e < end) {
-            long ms = q->runs_tmp[q->run_order[e]].m0, me = ms - st, n0 = q->nnodes; /* first and last node */
-            for (; e < end && q->runs_tmp[q->run_order[e]].m0 <= me + st; e++) {
+            long ms = q->tmp[q->order[e]].m0, me = ms - st, n0 = q->nnodes; /* first and last node */
+            for (; e < end && q->tmp[q->order[e]].m0 <= me + st; e++) {
                 ibm_run_t *o = &q->runs[nr++];
-                *o = q->runs_tmp[q->run_order[e]];
-                o->u0 = (int32_t)(n0 + (o->m0 - ms) / st);
+                *o = q->tmp[q->order[e]];
+                o->u0 = (int32_t)(n0 + (st == 1 ? o->m0 - ms : (o->m0 - ms) / st));
                 long oe = o->m0 + (o->len - 1) * st;
                 if (oe > me) me = oe;
             }
-            if (q->n_nruns == q->cap_nruns) {
-                q->cap_nruns = q->cap_nruns ? 2 * q->cap_nruns : 1024;
-                q->nruns_f = realloc(q->nruns_f, (size_t)q->cap_nruns * sizeof *q->nruns_f);
-                if (!q->nruns_f) die_local("immersed boundary: out of memory for %ld node runs", q->cap_nruns);
-            }
+            grow((void **)&q->nruns_f, &q->cap_nruns, q->n_nruns + 1, sizeof *q->nruns_f, "node runs");
             ibm_node_run_t *n = &q->nruns_f[q->n_nruns++];
             n->m0 = (int32_t)ms;
             n->n0 = (int32_t)n0;
@@ -361,63 +413,127 @@ static void sort_and_merge_runs(ibm_t *ibm)
             q->nnodes += n->len;
         }
     }
+    q->nruns = nr;
 }
 
-/* α of every run entry, in storage order, and Σ_p α_p at each forced node. */
-static void compute_alpha(ibm_t *ibm)
+/* α of the runs r0 .. r1−1 (one plane, nodes n0 .. n1−1), and Σ_p α_p at
+ * each of its forced nodes. */
+static void compute_alpha(ibm_t *ibm, long r0, long r1, long n0, long n1)
 {
     ibm_priv_t *q = ibm_priv(ibm);
     const grid_t *g = ibm->g;
-    double retraction = ibm->prm.retraction;
     long n = 0;
-    for (long ir = 0; ir < q->nruns; ir++) n += q->runs[ir].len;
-    if (n > q->cap_alpha || !q->alpha) {
-        q->cap_alpha = n + n / 4;
-        free(q->alpha);
-        q->alpha = xcalloc((size_t)q->cap_alpha, sizeof *q->alpha);
+    for (long ir = r0; ir < r1; ir++) n += q->runs[ir].len;
+    grow((void **)&q->alpha, &q->cap_alpha, q->nalpha + n, sizeof *q->alpha, "solid fractions");
+    if (n1 > q->cap_nodes) {
+        long cap = q->cap_nodes, cap2 = cap, cap3 = cap;
+        grow((void **)&q->node_asum, &cap, n1, sizeof(double), "nodes");
+        grow((void **)&q->node_target, &cap2, n1, sizeof(double), "nodes");
+        grow((void **)&q->node_imp, &cap3, n1, sizeof(double), "nodes");
+        q->cap_nodes = cap;
     }
-    if (q->nnodes > q->cap_nodes || !q->node_asum) {
-        q->cap_nodes = q->nnodes + q->nnodes / 4;
-        free(q->node_asum);
-        free(q->node_target);
-        free(q->node_imp);
-        q->node_asum = xcalloc((size_t)q->cap_nodes, sizeof(double));
-        q->node_target = xcalloc((size_t)q->cap_nodes, sizeof(double));
-        q->node_imp = xcalloc((size_t)q->cap_nodes, sizeof(double));
-    }
-    memset(q->node_asum, 0, (size_t)q->nnodes * sizeof(double));
-    /* node_imp counts the spheres at each node meanwhile */
-    memset(q->node_imp, 0, (size_t)q->nnodes * sizeof(double));
-    q->nalpha = 0;
-    for (long ir = 0; ir < q->nruns; ir++) {
+    /* the number of spheres at each node of the plane (nshared) */
+    grow((void **)&q->cnt, &q->cap_cnt, n1 - n0, sizeof *q->cnt, "nodes");
+    memset(q->node_asum + n0, 0, (size_t)(n1 - n0) * sizeof(double));
+    memset(q->cnt, 0, (size_t)(n1 - n0) * sizeof *q->cnt);
+    /* the cell size h is that of the plane */
+    alpha_runs(ibm, q->runs + r0, r1 - r0, q->hcell[q->runs[r0].c][ibm_node_i(g, q->runs[r0].m0)], q->alpha + q->nalpha);
+    for (long ir = r0; ir < r1; ir++) {
         ibm_run_t *run = &q->runs[ir];
-        double h = q->hcell[run->c][ibm_node_i(g, run->m0)], *al = q->alpha + q->nalpha;
-        double *A = q->node_asum + run->u0, *cnt = q->node_imp + run->u0;
+        const double *al = q->alpha + q->nalpha;
+        double *A = q->node_asum + run->u0;
+        int32_t *cnt = q->cnt + (run->u0 - n0);
         run->a0 = (int32_t)q->nalpha;
-        alpha_run(ibm->s[run->p].radius - retraction * h, run->r0, q->rdir, q->rstep, h, run->len, al);
         for (int k = 0; k < run->len; k++) {
             A[k] += al[k];
-            cnt[k] += 1.0;
+            cnt[k]++;
         }
         q->nalpha += run->len;
     }
-    double shared = 0.0;
-    for (long j = 0; j < q->nnodes; j++) shared += q->node_imp[j] > 1.0 ? q->node_imp[j] : 0.0;
-    q->nshared = (long)shared;
+    for (long j = 0; j < n1 - n0; j++) q->nshared += q->cnt[j] > 1 ? q->cnt[j] : 0;
 }
 
-void ibm_build_nodes(ibm_t *ibm)
+typedef struct {
+    double z;  /* centre along the run direction */
+    int32_t p;
+} zkey_t;
+
+static int by_run_coordinate(const void *a, const void *b)
 {
+    const zkey_t *i = a, *j = b;
+    return i->z < j->z ? -1 : i->z > j->z ? 1 : (i->p > j->p) - (i->p < j->p);
+}
+
+/* The node lists, plane by plane (component c, local x index i) in
+ * storage order: the spheres whose box reaches the plane generate their
+ * runs there, which are sorted, merged and given their α, and, while they
+ * are in cache, the targets of the forcing (targets != 0: from the
+ * spheres' current velocities, as set_targets() in forcing.c) and the
+ * momentum integrals of each sphere (mom != NULL: into its
+ * IBM_MOM..IBM_ANG+2, as ibm_momentum()). */
+void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
+{
+    const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
     build_ctx_t b = {.ibm = ibm, .q = q};
     if (alpha_tmax == 0.0) alpha_table_init();
-    q->nruns = 0;
-    for (b.p = 0; b.p < ibm->n; b.p++)
-        for (int c = 0; c < ibm->g->dim; c++) for_sphere_segments(ibm, &ibm->s[b.p], c, add_run, &b);
-    sort_and_merge_runs(ibm);
-    compute_alpha(ibm);
+    q->nruns = q->n_nruns = q->nnodes = q->nalpha = q->nshared = 0;
+    if (mom) ibm_sums_zero(ibm, mom, 0, 1);
+    if (targets) ibm_targets_note(ibm);
+    int *box = xcalloc(7 * (size_t)(ibm->n > 0 ? ibm->n : 1), sizeof *box); /* lo[3], hi[3], in the domain */
+    int32_t *head = xcalloc((size_t)g->nxl + 1, sizeof *head), *pair = NULL;
+    /* the spheres by their coordinate along the run direction */
+    zkey_t *zord = xcalloc((size_t)(ibm->n > 0 ? ibm->n : 1), sizeof *zord);
+    for (int p = 0; p < ibm->n; p++) zord[p] = (zkey_t){ibm->s[p].xa[q->rdir], p};
+    qsort(zord, (size_t)ibm->n, sizeof *zord, by_run_coordinate);
+    long npair = 0, cap_pair = 0;
+    for (int c = 0; c < g->dim; c++) {
+        /* the (sphere, unwrapped x index) pairs of each plane of this rank,
+         * the spheres of a plane by their run coordinate */
+        memset(head, 0, ((size_t)g->nxl + 1) * sizeof *head);
+        npair = 0;
+        for (int p = 0; p < ibm->n; p++) {
+            int *bx = box + 7 * p;
+            bx[6] = sphere_box(ibm, &ibm->s[p], c, bx, bx + 3);
+            if (!bx[6]) continue;
+            for (int ii = bx[0]; ii <= bx[3]; ii++) {
+                int il = (g->periodic[0] ? wrap(ii, g->n[0]) : ii) - g->ix0;
+                if (il >= 0 && il < g->nxl) head[il + 1]++, npair++;
+            }
+        }
+        grow((void **)&pair, &cap_pair, 2 * npair, sizeof *pair, "planes");
+        for (int i = 0; i < g->nxl; i++) head[i + 1] += head[i];
+        for (int o = 0; o < ibm->n; o++) {
+            int p = zord[o].p;
+            const int *bx = box + 7 * p;
+            if (!bx[6]) continue;
+            for (int ii = bx[0]; ii <= bx[3]; ii++) {
+                int il = (g->periodic[0] ? wrap(ii, g->n[0]) : ii) - g->ix0;
+                if (il >= 0 && il < g->nxl) pair[2 * head[il]] = p, pair[2 * head[il]++ + 1] = ii;
+            }
+        }
+        for (int i = g->nxl; i > 0; i--) head[i] = head[i - 1];
+        head[0] = 0;
+        for (int i = 0; i < g->nxl; i++) {
+            long r0 = q->nruns, n0 = q->nnodes;
+            q->ntmp = 0;
+            for (int k = head[i]; k < head[i + 1]; k++) {
+                b.p = pair[2 * k];
+                plane_segments(ibm, &ibm->s[b.p], c, pair[2 * k + 1], box + 7 * b.p, box + 7 * b.p + 3, add_run, &b);
+            }
+            if (q->ntmp == 0) continue;
+            sort_and_merge_plane(ibm);
+            compute_alpha(ibm, r0, q->nruns, n0, q->nnodes);
+            if (targets) ibm_targets_of(ibm, r0, q->nruns, n0, q->nnodes);
+            if (mom) ibm_sums_of(ibm, mom, r0, q->nruns, 0, 1);
+        }
+    }
+    free(box);
+    free(zord);
+    free(head);
+    free(pair);
     q->built = 1;
-    q->targets_valid = 0;
+    q->targets_valid = targets;
     ibm->nodes_forced = q->nalpha;
     ibm->nodes_shared = q->nshared;
 }
@@ -447,9 +563,10 @@ typedef struct {
     double R, band, retraction;
 } cell_ctx_t;
 
-static void add_cells(void *ctx, int c, long m0, int len, const double r0[3], double h)
+static void add_cells(void *ctx, int c, int line, long m0, int len, const double r0[3], double h)
 {
     (void)c;
+    (void)line;
     cell_ctx_t *b = ctx;
     const ibm_priv_t *q = ibm_priv(b->ibm);
     double r[3] = {r0[0], r0[1], r0[2]};

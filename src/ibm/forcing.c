@@ -80,28 +80,23 @@ static inline double forcing_beta(double a, double dt, double tau)
  * forcings), and each sphere's share of the accumulated impulses
  * (sphere_sums). */
 
-/* Ū at every forced node from the spheres' current velocities, and the
- * accumulated impulses reset.  Ū is kept when neither the node lists nor
- * any sphere's velocity changed since it was set (spheres at rest, a fixed
- * bed: the pass is skipped). */
-static void set_targets(ibm_t *ibm)
+void ibm_targets_note(ibm_t *ibm)
 {
     ibm_priv_t *q = ibm_priv(ibm);
-    double step = q->rstep;
-    int rd = q->rdir;
-    q->imp_fresh = 1; /* the next forcing starts the accumulation */
-    int same = q->targets_valid;
-    for (int p = 0; p < ibm->n && same; p++)
-        same = !memcmp(q->target_vel + 6 * p, ibm->s[p].u, 3 * sizeof(double)) &&
-               !memcmp(q->target_vel + 6 * p + 3, ibm->s[p].omega, 3 * sizeof(double));
-    if (same) return;
     for (int p = 0; p < ibm->n; p++) {
         memcpy(q->target_vel + 6 * p, ibm->s[p].u, 3 * sizeof(double));
         memcpy(q->target_vel + 6 * p + 3, ibm->s[p].omega, 3 * sizeof(double));
     }
-    q->targets_valid = 1;
-    memset(q->node_target, 0, (size_t)q->nnodes * sizeof(double));
-    for (long ir = 0; ir < q->nruns; ir++) {
+}
+
+void ibm_targets_of(ibm_t *ibm, long r0, long r1, long n0, long n1)
+{
+    ibm_priv_t *q = ibm_priv(ibm);
+    double step = q->rstep;
+    int rd = q->rdir;
+    if (n1 <= n0) return; /* (no nodes on this rank: node_target may be NULL) */
+    memset(q->node_target + n0, 0, (size_t)(n1 - n0) * sizeof(double));
+    for (long ir = r0; ir < r1; ir++) {
         const ibm_run_t *run = &q->runs[ir];
         const ibm_sphere_t *s = &ibm->s[run->p];
         const double *al = q->alpha + run->a0, *A = q->node_asum + run->u0;
@@ -109,6 +104,24 @@ static void set_targets(ibm_t *ibm)
         for (int k = 0; k < run->len; k++, r[rd] += step)
             if (al[k] > 0.0) T[k] += al[k] / A[k] * ibm_rigid_velocity(s, run->c, r);
     }
+}
+
+/* Ū at every forced node from the spheres' current velocities, and the
+ * accumulated impulses reset.  Ū is kept when neither the node lists nor
+ * any sphere's velocity changed since it was set (spheres at rest, a fixed
+ * bed, or set by the build of the node lists: the pass is skipped). */
+static void set_targets(ibm_t *ibm)
+{
+    ibm_priv_t *q = ibm_priv(ibm);
+    q->imp_fresh = 1; /* the next forcing starts the accumulation */
+    int same = q->targets_valid;
+    for (int p = 0; p < ibm->n && same; p++)
+        same = !memcmp(q->target_vel + 6 * p, ibm->s[p].u, 3 * sizeof(double)) &&
+               !memcmp(q->target_vel + 6 * p + 3, ibm->s[p].omega, 3 * sizeof(double));
+    if (same) return;
+    ibm_targets_note(ibm);
+    q->targets_valid = 1;
+    ibm_targets_of(ibm, 0, q->nruns, 0, q->nnodes);
 }
 
 /* One forcing u ← u + β (Ū − u) of every forced node, the impulse added
@@ -166,7 +179,16 @@ static void force_nodes(ibm_t *ibm, double dt)
  * Along a run only the run coordinate z of r = r⊥ + z e_run varies, so the
  * moment of the values a_k e_c of a run is r⊥ × e_c Σa_k + e_run × e_c
  * Σ z_k a_k: two sums per run instead of a cross product per node. */
-static void sphere_sums(ibm_t *ibm, double *sum_all, int impulses, int momentum)
+void ibm_sums_zero(ibm_t *ibm, double *sum_all, int impulses, int momentum)
+{
+    for (int p = 0; p < ibm->n; p++)
+        for (int d = 0; d < 6; d++) {
+            if (impulses) sum_all[(long)p * IBM_NSUM + IBM_FIMP + d] = 0.0;
+            if (momentum) sum_all[(long)p * IBM_NSUM + IBM_MOM + d] = 0.0;
+        }
+}
+
+void ibm_sums_of(ibm_t *ibm, double *sum_all, long r0, long r1, int impulses, int momentum)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
@@ -174,12 +196,7 @@ static void sphere_sums(ibm_t *ibm, double *sum_all, int impulses, int momentum)
     double step = q->rstep, e_run[3] = {0, 0, 0};
     int rd = q->rdir;
     e_run[rd] = 1.0;
-    for (int p = 0; p < ibm->n; p++)
-        for (int d = 0; d < 6; d++) {
-            if (impulses) sum_all[(long)p * IBM_NSUM + IBM_FIMP + d] = 0.0;
-            if (momentum) sum_all[(long)p * IBM_NSUM + IBM_MOM + d] = 0.0;
-        }
-    for (long ir = 0; ir < q->nruns; ir++) {
+    for (long ir = r0; ir < r1; ir++) {
         const ibm_run_t *run = &q->runs[ir];
         int c = run->c;
         double *sum = sum_all + (long)run->p * IBM_NSUM, t0[3], t1[3];
@@ -188,13 +205,21 @@ static void sphere_sums(ibm_t *ibm, double *sum_all, int impulses, int momentum)
         double vol = q->vol[c][ibm_node_i(g, run->m0)], z0 = run->r0[rd], rperp[3] = {run->r0[0], run->r0[1], run->r0[2]};
         double j0 = 0, j1 = 0, m0 = 0, m1 = 0;
         rperp[rd] = 0.0;
-        if (impulses)
+        if (impulses && momentum) /* one loop: four independent sums, one load of α */
+            for (int k = 0; k < run->len; k++) {
+                double share = al[k] > 0.0 ? al[k] / A[k] * imp[k] : 0.0, a = al[k] * u[k * st], z = z0 + k * step;
+                j0 += share;
+                j1 += z * share;
+                m0 += a;
+                m1 += z * a;
+            }
+        else if (impulses)
             for (int k = 0; k < run->len; k++) {
                 double share = al[k] > 0.0 ? al[k] / A[k] * imp[k] : 0.0;
                 j0 += share;
                 j1 += (z0 + k * step) * share;
             }
-        if (momentum)
+        else if (momentum)
             for (int k = 0; k < run->len; k++) {
                 double a = al[k] * u[k * st];
                 m0 += a;
@@ -215,6 +240,12 @@ static void sphere_sums(ibm_t *ibm, double *sum_all, int impulses, int momentum)
     }
 }
 
+static void sphere_sums(ibm_t *ibm, double *sum_all, int impulses, int momentum)
+{
+    ibm_sums_zero(ibm, sum_all, impulses, momentum);
+    ibm_sums_of(ibm, sum_all, 0, ibm_priv(ibm)->nruns, impulses, momentum);
+}
+
 void ibm_momentum(ibm_t *ibm, double *sum_all) { sphere_sums(ibm, sum_all, 0, 1); }
 
 static void reduce_sums(ibm_t *ibm)
@@ -229,10 +260,9 @@ void ibm_rebuild_geometry(ibm_t *ibm)
 {
     double w0 = wtime();
     ibm_priv_t *q = ibm_priv(ibm);
-    ibm_build_nodes(ibm);
-    double w1 = wtime();
     memset(q->sum, 0, (size_t)ibm->n * IBM_NSUM * sizeof(double));
-    ibm_momentum(ibm, q->sum);
+    ibm_build_nodes(ibm, q->sum, 0);
+    double w1 = wtime();
     reduce_sums(ibm);
     for (int p = 0; p < ibm->n; p++)
         for (int d = 0; d < 6; d++) q->mom_prev[6 * p + d] = q->sum[(long)p * IBM_NSUM + IBM_MOM + d];
@@ -303,8 +333,7 @@ static int carry_external_moves(ibm_t *ibm)
         moved = mv[p] = 1;
     }
     if (moved) {
-        ibm_build_nodes(ibm);
-        ibm_momentum(ibm, q->sum);
+        ibm_build_nodes(ibm, q->sum, 1); /* the targets too: the step starts with them */
         reduce_sums(ibm);
         for (int p = 0; p < ibm->n; p++)
             if (mv[p])
@@ -530,9 +559,9 @@ void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx)
         moved |= memcmp(xa0, s->xa, sizeof xa0) != 0;
     }
     double w0 = wtime();
-    if (moved) ibm_build_nodes(ibm);
+    if (moved) ibm_build_nodes(ibm, q->sum, 0);
     double w1 = wtime();
-    ibm_momentum(ibm, q->sum);
+    if (!moved) ibm_momentum(ibm, q->sum);
     reduce_sums(ibm);
     for (int p = 0; p < ibm->n; p++) {
         double J[3], K[3];

@@ -201,7 +201,7 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
         }
     }
     size_t nn = (size_t)(n > 0 ? n : 1);
-    q->line_head = xcalloc((size_t)g->dim * (size_t)g->nxl * (size_t)(g->dim == 3 ? g->n[1] : 1) + 1, sizeof(int32_t));
+    q->line_head = xcalloc((size_t)(g->dim == 3 ? g->n[1] : 1) + 1, sizeof(int32_t));
     q->rdir = g->dim == 3 ? 2 : 1;
     q->rstride = g->dim == 3 ? 1 : g->sy;
     q->rstep = g->dim == 3 ? g->dz : g->dy;
@@ -241,8 +241,9 @@ void ibm_free(ibm_t *ibm)
     free(q->node_target);
     free(q->node_imp);
     free(q->line_head);
-    free(q->run_order);
-    free(q->runs_tmp);
+    free(q->order);
+    free(q->tmp);
+    free(q->cnt);
     free(q->sum);
     free(q->mom_prev);
     free(q->target_vel);

@@ -14,15 +14,15 @@
  * applied), with solid fraction alpha[a0 + q], and is the forced node
  * u0 + q of the merged lists below.  A sphere + band is convex, so a grid
  * line meets it in one segment (two if a periodic face cuts it).  The runs
- * of all spheres are kept in storage order (by grid line, then m0), so
- * that every pass over them streams through the velocity field and the α
- * array instead of jumping from sphere to sphere. */
+ * of all spheres are kept in storage order (by grid line, then m0, then
+ * sphere), so that every pass over them streams through the velocity field
+ * and the α array instead of jumping from sphere to sphere. */
 typedef struct {
     double r0[3];
     int32_t m0;     /* G_IDX of the first node */
     int32_t a0;     /* index of its α in the alpha array */
     int32_t u0;     /* index of its first node among the forced nodes */
-    int32_t line;   /* grid line: (component, local x index[, y index]) */
+    int32_t line;   /* grid line in its plane (component, x index): the y index in 3-D, 0 in 2-D */
     int32_t p;      /* sphere */
     int16_t len;
     uint8_t c;      /* velocity component */
@@ -46,8 +46,8 @@ typedef struct {
 enum { IBM_FIMP = 0, IBM_TIMP = 3, IBM_MOM = 6, IBM_ANG = 9, IBM_NSUM = 12 };
 
 typedef struct {
-    /* runs of all spheres in storage order (runs_tmp: as generated) */
-    ibm_run_t *runs, *runs_tmp;
+    /* runs of all spheres in storage order */
+    ibm_run_t *runs;
     long nruns, cap_runs;
     double *alpha;
     long nalpha, cap_alpha, nshared; /* nshared: entries at nodes that another sphere's band reaches */
@@ -62,9 +62,13 @@ typedef struct {
     long n_nruns, cap_nruns;
     double *node_asum, *node_target, *node_imp;
     long nnodes, cap_nodes;
-    int32_t *line_head;  /* scratch of the sort: first of each grid line's runs in run_order */
-    int32_t *run_order;
-    long cap_next;
+    /* scratch of the build, one plane at a time (alpha.c): the runs as
+     * generated, their sorted order, the first of each grid line's runs in
+     * it, and the number of spheres at each node */
+    ibm_run_t *tmp;
+    long ntmp, cap_tmp;
+    int32_t *order, *line_head, *cnt;
+    long cap_order, cap_cnt;
     int built;         /* node lists exist */
     int imp_fresh;     /* node_imp is to be restarted by the next forcing */
     int targets_valid; /* node_target was set from these node lists and the velocities in target_vel */
@@ -88,7 +92,10 @@ typedef struct {
 static inline ibm_priv_t *ibm_priv(const ibm_t *ibm) { return (ibm_priv_t *)ibm->priv; }
 
 /* alpha.c */
-void ibm_build_nodes(ibm_t *ibm);
+/* The node lists at the current centres xa, with, in the same pass, the
+ * targets of the forcing (targets != 0) and the momentum integrals into
+ * mom (not NULL; see ibm_sums_of). */
+void ibm_build_nodes(ibm_t *ibm, double *mom, int targets);
 /* Local x index of storage index m. */
 static inline int ibm_node_i(const grid_t *g, long m) { return (int)(m / g->sx) - 1; }
 /* Rigid-body velocity component c of sphere s at offset r. */
@@ -101,7 +108,17 @@ static inline double ibm_rigid_velocity(const ibm_sphere_t *s, int c, const doub
     }
 }
 /* forcing.c */
-void ibm_momentum(ibm_t *ibm, double *out6);
+/* ∫ α_p u dV and ∫ α_p r × u dV of every sphere into sum_all (n × IBM_NSUM, IBM_MOM..IBM_ANG+2). */
+void ibm_momentum(ibm_t *ibm, double *sum_all);
+/* The per-sphere sums over the runs r0 .. r1−1 added to sum_all (n ×
+ * IBM_NSUM): the shares of the forcing impulses (impulses) and the momentum
+ * integrals (momentum); ibm_sums_zero() clears them first. */
+void ibm_sums_zero(ibm_t *ibm, double *sum_all, int impulses, int momentum);
+void ibm_sums_of(ibm_t *ibm, double *sum_all, long r0, long r1, int impulses, int momentum);
+/* The targets Ū of the nodes n0 .. n1−1 from the runs r0 .. r1−1 that
+ * cover them, from the spheres' velocities recorded by ibm_targets_note(). */
+void ibm_targets_note(ibm_t *ibm);
+void ibm_targets_of(ibm_t *ibm, long r0, long r1, long n0, long n1);
 void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx);
 void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx);
 

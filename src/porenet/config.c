@@ -22,6 +22,9 @@ static const cfg_key_t porenet_keys[] = {
      "fluid density (kg/m^3): buoyancy and the pore Reynolds number"},
     {"porenet", "alpha", CFG_DOUBLE, "0.5", 1e-6, 1e6, NULL,
      "conductance factor alpha in g = alpha A R_h^2/mu (Catalano eq. 3.4; 1/2: Hagen-Poiseuille analogy)"},
+    {"porenet", "wall_throats", CFG_ENUM, "mirror", 1, 0, "mirror|yade",
+     "conductance of the throats in a wall plane: mirror (exact symmetry) or yade (YADE FlowEngine's model: one "
+     "merged throat per pore pair, R_h x 2^-1/4 per slip wall; for comparisons with YADE)"},
     {"porenet", "solver", CFG_ENUM, "cholmod", 1, 0, "cholmod|pcg",
      "pore-pressure system: CHOLMOD Cholesky (factorised once per triangulation) or Jacobi-preconditioned CG"},
     {"porenet", "pcg_tol", CFG_DOUBLE, "1e-10", 1e-16, 1e-2, NULL, "pcg: relative residual at which CG stops"},
@@ -32,7 +35,8 @@ static const cfg_key_t porenet_keys[] = {
     {"porenet", "margin", CFG_DOUBLE, "0", 0, BIG, NULL,
      "width of the layer of sphere images across the faces (m); 0: 3 largest diameters"},
     {"porenet", "packing", CFG_STRING, NULL, 1, 0, NULL,
-     "fixed packing (text: x y z r per line, # comments) when the scene has no DEM particles ([particles])"},
+     "fixed packing when the scene has no DEM particles ([particles]): text (x y z r per line, # comments) "
+     "or HDF5 (.h5: datasets position [n][3] and radius, the layout of ibm.spheres_file)"},
     {"porenet", "gradient", CFG_VEC3, "0 0 0", -BIG, BIG, NULL,
      "mean pressure gradient imposed along the periodic axes (Pa/m)"},
     FACE_KEYS("x_lo"), FACE_KEYS("x_hi"), FACE_KEYS("y_lo"), FACE_KEYS("y_hi"), FACE_KEYS("z_lo"), FACE_KEYS("z_hi"),
@@ -75,6 +79,7 @@ void pn_model_from_config(cfg_t *cfg, pn_model_t *m)
     }
     m->prm.mu = cfg_double(cfg, "porenet", "viscosity");
     m->prm.alpha = cfg_double(cfg, "porenet", "alpha");
+    m->prm.wall_model = cfg_enum(cfg, "porenet", "wall_throats") == 1 ? PN_WALL_YADE : PN_WALL_MIRROR;
     m->rho_f = cfg_double(cfg, "porenet", "fluid_density");
     m->kind = cfg_enum(cfg, "porenet", "solver") == 0 ? PN_SOLVER_CHOLMOD : PN_SOLVER_PCG;
     m->pcg_tol = cfg_double(cfg, "porenet", "pcg_tol");
