@@ -43,7 +43,17 @@ static inline double linear_normal(const dem_contact_prm_t *cp, double delta, do
     return kn * delta - meff * cp->gn_rel * vn_damp;
 }
 
+/* K = k_n/m*: the force k_n max(δ, 0) has a kink of this stiffness (per
+ * unit effective mass) at δ = 0, which the kernel treats at the first and the
+ * last step of a contact ([contact] spring_kink, docs/theory.md §7.7). */
+static inline double linear_kink(const dem_contact_prm_t *cp, double meff, double imeff)
+{
+    (void)meff;
+    return cp->kn_abs * imeff + cp->kn_rel;
+}
+
 #define LAW_NORMAL linear_normal
+#define LAW_KINK linear_kink
 #define LAW_PAIRS linear_pairs
 #define LAW_WALL linear_wall
 #include "dem_kernel.inc"
@@ -116,6 +126,7 @@ static void linear_setup(dem_t *d, cfg_t *cfg)
 {
     dem_contact_prm_t *cp = &d->cp;
     cp->kt_ratio = cfg_double(cfg, "contact", "kt_ratio");
+    cp->kink_energy = cfg_enum(cfg, "contact", "spring_kink") == 0;
     const int stiffness = cfg_enum(cfg, "contact", "parameters") == 1;
     cp->kn_abs = cp->kn_rel = cp->gn_rel = 0.0;
     if (stiffness) {
