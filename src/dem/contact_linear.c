@@ -122,11 +122,18 @@ static void calibrate_clipped(double e, double tc, double *K, double *G)
     }
 }
 
+/* The onset/separation weights of the spring (dem_kernel.inc) where the
+ * force keeps its kink at δ = 0 at both ends: unclipped, or without damping
+ * (a clipped law with damping lets go before δ = 0, at the clip). */
+static void linear_kink_setup(dem_contact_prm_t *cp, cfg_t *cfg)
+{
+    cp->kink_energy = cfg_enum(cfg, "contact", "spring_kink") == 0 && (!cp->clip || cp->gn_rel == 0.0);
+}
+
 static void linear_setup(dem_t *d, cfg_t *cfg)
 {
     dem_contact_prm_t *cp = &d->cp;
     cp->kt_ratio = cfg_double(cfg, "contact", "kt_ratio");
-    cp->kink_energy = cfg_enum(cfg, "contact", "spring_kink") == 0;
     const int stiffness = cfg_enum(cfg, "contact", "parameters") == 1;
     cp->kn_abs = cp->kn_rel = cp->gn_rel = 0.0;
     if (stiffness) {
@@ -135,6 +142,7 @@ static void linear_setup(dem_t *d, cfg_t *cfg)
         cp->restitution = cp->tc_given = 0.0;
         snprintf(cp->summary, sizeof cp->summary, "linear contact, k_n = %.6g N/m, gamma_n/m* = %.6g s^-1, k_t/k_n = %g%s",
                  cp->kn_abs, cp->gn_rel, cp->kt_ratio, cp->clip ? " (normal force clipped)" : "");
+        linear_kink_setup(cp, cfg);
         return;
     }
     const double e = cfg_double(cfg, "contact", "restitution");
@@ -152,6 +160,7 @@ static void linear_setup(dem_t *d, cfg_t *cfg)
                      "'clipped' calibrates the clipped law; with normal_clip = false use calibration = seed");
         calibrate_clipped(e, tc, &cp->kn_rel, &cp->gn_rel);
     }
+    linear_kink_setup(cp, cfg);
     double dur, eeff;
     linear_oscillator(cp->kn_rel, cp->gn_rel, cp->clip, &dur, &eeff);
     snprintf(cp->summary, sizeof cp->summary,
