@@ -35,7 +35,7 @@
 #include "modules.h"
 #include "testutil.h"
 
-static dem_t *gas(int n, double e, double mu, double mu_r, int nc, unsigned long seed, const char *par)
+static dem_t *gas(int n, double e, double mu, double mu_r, int nc, unsigned long seed, const char *par, const char *kink)
 {
     char text[1024];
     snprintf(text, sizeof text,
@@ -43,8 +43,8 @@ static dem_t *gas(int n, double e, double mu, double mu_r, int nc, unsigned long
              "[particles]\nsource = insert\ncount = %d\nradius = 1e-3\npolydispersity = 0.2\nseed = %lu\n"
              "velocity_spread = 0.5\n"
              "[contact]\nrestitution = %.17g\ncontact_time = 1e-4\nfriction = %g\nrolling_friction = %g\n"
-             "[dem]\ngravity = 0 0 0\nsteps_per_contact = %d\nmax_overlap = 0.2\nparallel = %s\n",
-             n, seed, e, mu, mu_r, nc, par);
+             "spring_kink = %s\n[dem]\ngravity = 0 0 0\nsteps_per_contact = %d\nmax_overlap = 0.2\nparallel = %s\n",
+             n, seed, e, mu, mu_r, kink, nc, par);
     cfg_t *cfg = cfg_load_string("gas.ini", text, 0, NULL);
     assert_non_null(cfg);
     dem_t *d = dem_create_from_config(cfg, MPI_COMM_WORLD);
@@ -122,18 +122,7 @@ static void test_energy_binary(void **state)
  * steps without any force (see the header). */
 static void gas_run(int nc, const char *kink, long contacts, double *drift, long *counted, long *multi)
 {
-    char text[1024];
-    snprintf(text, sizeof text,
-             "[domain]\nlength = 0.02 0.02 0.02\n[walls]\nfaces = none\n"
-             "[particles]\nsource = insert\ncount = 100\nradius = 1e-3\npolydispersity = 0.2\nseed = 11\n"
-             "velocity_spread = 0.5\n"
-             "[contact]\nrestitution = 1\ncontact_time = 1e-4\nfriction = 0\nspring_kink = %s\n"
-             "[dem]\ngravity = 0 0 0\nsteps_per_contact = %d\nmax_overlap = 0.2\nparallel = replicated\n",
-             kink, nc);
-    cfg_t *cfg = cfg_load_string("gas.ini", text, 0, NULL);
-    assert_non_null(cfg);
-    dem_t *d = dem_create_from_config(cfg, MPI_COMM_WORLD);
-    cfg_free(cfg);
+    dem_t *d = gas(100, 1.0, 0.0, 0.0, nc, 11, "replicated", kink);
     dem_diag_t g;
     double e0 = -1;
     long c0 = 0;
@@ -193,7 +182,7 @@ static void test_energy_gas(void **state)
 
 static void test_momentum(void **state)
 {
-    dem_t *d = gas(400, 0.5, 0.5, 0.1, 50, 12, "split");
+    dem_t *d = gas(400, 0.5, 0.5, 0.1, 50, 12, "split", "energy");
     assert_int_equal(dem_step(d), DEM_OK);
     dem_diag_t g0, g;
     dem_diag(d, &g0);
