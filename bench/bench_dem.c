@@ -6,7 +6,8 @@
  * default), dt = 2e-6 s, skin 0.1 d, gravity −9.81 z.
  *
  * usage: bench_dem DATA NSTEPS TAG [OUT.data] [replicated|split] [THREADS]
- * Prints one line "BENCH tag ..." with the loop time, particle-steps/s and the
+ * Prints one line "BENCH tag ..." with the loop time (wall and CPU time of rank 0's
+ * process: on a shared machine the CPU time is the robust measure), particle-steps/s and the
  * fingerprint of the final state (as the LIGGGHTS input computes it:
  * centre-of-mass height, packing fraction N V_p/(L_x L_y 2 z̄), mean
  * coordination number 2 × overlapping pairs / N), and the memory per particle.
@@ -52,8 +53,9 @@ int main(int argc, char **argv)
     const int n = dem_count(d);
     dem_status_t st = dem_run_steps(d, 0); /* set up: lists and forces of the initial state */
     MPI_Barrier(MPI_COMM_WORLD);
-    const double t0 = wtime();
+    const double t0 = wtime(), c0 = cputime();
     if (st == DEM_OK) st = dem_run_steps(d, nsteps);
+    const double cpu = cputime() - c0;
     MPI_Barrier(MPI_COMM_WORLD);
     const double loop = wtime() - t0;
     if (st != DEM_OK) die("bench_dem: %s", dem_error(d));
@@ -90,11 +92,12 @@ int main(int argc, char **argv)
     const double phi = n * vp / (L[0] * L[1] * 2.0 * g.com[2]);
     const double zmean = 2.0 * g.n_contacts / n;
     const double pps = loop > 0 ? (double)n * nsteps / loop : 0;
+    const double cpu_pps = cpu > 0 ? (double)n * nsteps / cpu : 0;
     const long rss = peak_rss_bytes();
-    msg("BENCH %s: ranks= %d threads= %d N= %d steps= %ld loop= %.4f s particle_steps_per_s= %.6g zbar= %.10g zmax= %.10g "
+    msg("BENCH %s: ranks= %d threads= %d N= %d steps= %ld loop= %.4f s particle_steps_per_s= %.6g cpu= %.4f s cpu_particle_steps_per_s= %.6g zbar= %.10g zmax= %.10g "
         "phi_com= %.6f Zmean= %.5f ke= %.6g mem_alloc_per_particle= %.1f B peak_rss_per_particle= %.1f B "
         "(rss growth %.1f B) rebuilds= %ld\n",
-        tag, mpi_size(), threads, n, nsteps, loop, pps, g.com[2], zmax, phi, zmean, g.ke_trans, dem_memory_per_particle(d),
+        tag, mpi_size(), threads, n, nsteps, loop, pps, cpu, cpu_pps, g.com[2], zmax, phi, zmean, g.ke_trans, dem_memory_per_particle(d),
         (double)rss / n, (double)(rss - rss0) / n, g.rebuilds);
     dem_print_timers(d);
     if (out) dem_write_lammps_data(d, out);

@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """Called by the LIGGGHTS/LAMMPS benchmark inputs through `shell` around the
 timed loop: appends "<label> <wall time> <cpu time of the simulation process>"
-to a file.  The simulation runs `sh -c` which runs this script, so the
-simulation process is the grandparent.
+to a file.  The simulation calls system(), i.e. `sh -c`, which may exec this
+script in place of the shell (dash does): the simulation process is the first
+ancestor that is not a shell.
 
 usage: cpustamp.py LABEL FILE
 """
@@ -23,9 +24,17 @@ def parent_of(pid):
         return int(f.read().rsplit(")", 1)[1].split()[1])
 
 
+def name_of(pid):
+    with open("/proc/%d/stat" % pid) as f:
+        text = f.read()
+    return text[text.index("(") + 1:text.rindex(")")]
+
+
 def main():
     label, out = sys.argv[1], sys.argv[2]
-    sim = parent_of(os.getppid())
+    sim = os.getppid()
+    while name_of(sim) in ("sh", "dash", "bash") and sim > 1:
+        sim = parent_of(sim)
     with open(out, "a") as f:
         f.write("%s %.6f %.3f\n" % (label, time.time(), cpu_seconds(sim)))
 

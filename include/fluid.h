@@ -25,11 +25,19 @@ typedef void (*fluid_stage_hook_t)(fluid_t *f, int stage, double dt_stage, void 
  * (γ_k + ζ_k) Δt, i.e. to t + (8/15, 2/3, 1) Δt. */
 extern const double fluid_rk_gamma[3], fluid_rk_zeta[3];
 
+/* Ghost value of a wall-tangential velocity at a no-slip wall, as the
+ * viscous operator sees it (docs/theory.md §4.3): the linear extrapolation
+ * 2U − u_0 (its Laplacian is exact for linear profiles), or the quadratic one
+ * through U, u_0, u_1 (exact for quadratic profiles: plane Poiseuille and
+ * Hagen–Poiseuille on a uniform grid). */
+typedef enum { WALL_GHOST_LINEAR = 0, WALL_GHOST_QUADRATIC = 1 } wall_ghost_t;
+
 typedef struct {
     double nu;            /* kinematic viscosity */
     double rho;           /* density (for forces and output in physical units) */
     double body_force[3]; /* acceleration driving the flow (e.g. a pressure gradient) */
     int implicit_viscous; /* 1: Crank–Nicolson, 0: explicit */
+    wall_ghost_t wall_ghost; /* no-slip wall closure of the viscous term */
     double cfl;           /* convective CFL target of the adaptive step */
     double fourier;       /* viscous stability target (explicit only) */
     double dt_fixed;      /* > 0: constant time step */

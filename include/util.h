@@ -25,6 +25,8 @@ void die_local(const char *fmt, ...) __attribute__((format(printf, 1, 2), noretu
 void *xcalloc(size_t n, size_t size);
 
 double wtime(void);
+/* CPU time of the whole process (all threads), s: the benchmarks on a shared machine. */
+double cputime(void);
 /* Peak resident set size of this process in bytes (from /proc/self/status). */
 long peak_rss_bytes(void);
 

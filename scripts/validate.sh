@@ -123,6 +123,13 @@ IBM_FULL3D=1 IBM_TESTS=test_settling_3d $MPIRUN -np 2 "$BUILD/tests/test_ibm_set
 section "coupling: bouncing sphere (Izard Fig. 3.3), phases, no lubrication, D/dx = 8..40, 3-D"
 BUILD=$BUILD OUT=$OUT bash scripts/validate_coupling.sh || fail "coupling bouncing sphere"
 
+# --- permeability: the same packing of 200 spheres through the resolved solver (D/dx = 8.6,
+# 12.9, 17.2) and the pore network, and the simple cubic array against Zick & Homsy (1982)
+# at D/dx = 8, 12, 16 (scripts/permeability_crosscheck.sh; table in
+# $OUT/permeability_crosscheck/table.md; about 18 min on one rank of the loaded machine).
+section "permeability: resolved solver against the pore network on the same packing (issue 6)"
+BUILD=$BUILD OUT=$OUT bash scripts/permeability_crosscheck.sh || fail "permeability cross-check"
+
 # (further modules: add sections here)
 
 echo

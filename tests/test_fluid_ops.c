@@ -411,13 +411,14 @@ static double smooth_fn(int c, const double x[3], double t, const void *ctx)
     return cos(0.7 * x[0] + x[1]) * sin(1.9 * x[2]);
 }
 
-static void check_viscous_identity(geom_t geom, const bc_t *bc)
+static void check_viscous_identity(geom_t geom, const bc_t *bc, wall_ghost_t wg)
 {
     int n[3] = {16, 12, geom == GEOM_3D ? 10 : 1};
     double L[3] = {1, 1.2, 0.9};
     grid_t *g = grid_create(geom, n, L, NULL, bc, STRETCH_TANH_BOTH, 2.0, MPI_COMM_WORLD);
     double nu = 0.37;
     fluid_params_t prm = ft_params(nu, 0);
+    prm.wall_ghost = wg;
     fluid_t *f = fluid_create(g, &prm);
     ft_set_velocity(f, smooth_fn, 0, NULL);
     double *V[3] = {field_alloc(g), field_alloc(g), field_alloc(g)}, *R[3] = {field_alloc(g), field_alloc(g), field_alloc(g)};
@@ -453,10 +454,15 @@ static void check_viscous_identity(geom_t geom, const bc_t *bc)
     m = grid_max(g, m);
     mr = grid_max(g, mr);
     s = grid_max(g, s);
-    msg("  %d-D viscous term vs ν(poisson_apply + wall terms): max difference %.2e; vs the fused right-hand side "
-        "%.2e; of max %.2e\n",
-        g->dim, m, mr, s);
-    assert_true(m < 1e-13 * s);
+    if (wg == WALL_GHOST_LINEAR) {
+        msg("  %d-D viscous term vs ν(poisson_apply + wall terms): max difference %.2e; vs the fused right-hand side "
+            "%.2e; of max %.2e\n",
+            g->dim, m, mr, s);
+        assert_true(m < 1e-13 * s);
+    } else
+        msg("  %d-D viscous term with the quadratic wall ghost vs the fused right-hand side: max difference %.2e of "
+            "max %.2e\n",
+            g->dim, mr, s);
     assert_true(mr < 1e-13 * s);
     for (int c = 0; c < 3; c++) {
         free(V[c]);
@@ -474,7 +480,8 @@ static void test_viscous_is_poisson_operator(void **state)
     bc.vel[1][1][0] = 1.0;
     bc.vel[0][0][1] = 0.3;
     bc.vel[0][1][1] = -0.7;
-    check_viscous_identity(GEOM_2D, &bc);
+    check_viscous_identity(GEOM_2D, &bc, WALL_GHOST_LINEAR);
+    check_viscous_identity(GEOM_2D, &bc, WALL_GHOST_QUADRATIC);
     memset(&bc, 0, sizeof bc);
     bc.type[0][0] = bc.type[0][1] = BC_NOSLIP;
     bc.type[1][0] = bc.type[1][1] = BC_FREESLIP;
@@ -483,7 +490,143 @@ static void test_viscous_is_poisson_operator(void **state)
     bc.vel[0][1][2] = -0.4;
     bc.vel[2][1][0] = 1.0;
     bc.vel[2][0][1] = 0.5;
-    check_viscous_identity(GEOM_3D, &bc);
+    check_viscous_identity(GEOM_3D, &bc, WALL_GHOST_LINEAR);
+    check_viscous_identity(GEOM_3D, &bc, WALL_GHOST_QUADRATIC);
+}
+
+/* The quadratic wall ghost (docs/theory.md §4.3).  (a) On a uniform grid the
+ * viscous operator with it is exact for a Couette–Poiseuille profile
+ * u = U_0 + (U_1 − U_0) s/H + c s(H − s) between no-slip walls (L u = −2c at
+ * every unknown, walls in x, y or z) and for the pipe profile
+ * u_z = U + b(R² − r²) (L u = −4b); with the linear ghost the wall cells are
+ * off by exactly ν u''/4 (ghost 2U − u_0 = u(−h/2) − u''h²/4, times 1/h²).
+ * (b) On a stretched x grid the quadratic ghost is the parabola's value at
+ * the ghost centre: the quadratic and linear operators differ at the wall
+ * cell by c_wall (p(x_g) − (2U − u_0)) with c_wall = 1/(Δx_c,−1 Δx_f,0).
+ * Tolerance: 1e-12 of ν max|u|/Δ², the scale of the terms that cancel. */
+typedef struct {
+    int dw, axi;
+    double H, U0, U1, c;
+} poly_t;
+
+static double poly_fn(int comp, const double x[3], double t, const void *ctx)
+{
+    (void)t;
+    const poly_t *p = ctx;
+    if (comp == p->dw) return 0.0;
+    double s = x[p->dw], U0 = p->U0 + 0.1 * comp, U1 = p->U1 - 0.2 * comp;
+    if (p->axi) return U1 + p->c * (p->H * p->H - s * s);
+    return U0 + (U1 - U0) * s / p->H + p->c * s * (p->H - s);
+}
+
+/* max |ν L u − expected| over the tangential unknowns, and (linear ghost)
+ * the same over the cells off the walls */
+static void check_poly(geom_t geom, int dw, stretch_t st, wall_ghost_t wg, const poly_t *pl, double *err,
+                       double *err_wall, double *scale, double *V[3], fluid_t **fp, grid_t **gp)
+{
+    int n[3] = {16, 12, geom == GEOM_3D ? 10 : 1};
+    double L[3] = {1, 1, 1};
+    bc_t bc = {0};
+    bc.type[dw][0] = geom == GEOM_AXI ? BC_AXIS : BC_NOSLIP;
+    bc.type[dw][1] = BC_NOSLIP;
+    for (int c = 0; c < 3; c++)
+        if (c != dw) {
+            bc.vel[dw][0][c] = geom == GEOM_AXI ? 0.0 : pl->U0 + 0.1 * c;
+            bc.vel[dw][1][c] = pl->U1 - 0.2 * c;
+        }
+    grid_t *g = grid_create(geom, n, L, NULL, &bc, st, 1.5, MPI_COMM_WORLD);
+    double nu = 0.37;
+    fluid_params_t prm = ft_params(nu, 0);
+    prm.wall_ghost = wg;
+    fluid_t *f = fluid_create(g, &prm);
+    ft_set_velocity(f, poly_fn, 0, pl);
+    for (int c = 0; c < g->dim; c++) V[c] = field_alloc(g);
+    fluid_viscous(f, V);
+    double expect = nu * (pl->axi ? -4.0 * pl->c : -2.0 * pl->c), m = 0, mw = 0, um = 0;
+    for (int c = 0; c < g->dim; c++) {
+        if (c == dw) continue;
+        FT_FOR_UNKNOWNS(g, c, i, j, k)
+        {
+            int idx[3] = {i + g->ix0, j, k};
+            double e = fabs(V[c][G_IDX(g, i, j, k)] - expect);
+            if (idx[dw] == g->n[dw] - 1 || (idx[dw] == 0 && !pl->axi)) mw = fmax(mw, e);
+            else m = fmax(m, e);
+            um = fmax(um, fabs(f->u[c][G_IDX(g, i, j, k)]));
+        }
+    }
+    double h = dw == 0 ? fmin(g->gdxf[0], g->gdxf[g->n[0] - 1]) : dw == 1 ? g->dy : g->dz;
+    *err = grid_max(g, m);
+    *err_wall = grid_max(g, mw);
+    *scale = nu * grid_max(g, um) / (h * h);
+    *fp = f;
+    *gp = g;
+}
+
+static void free_poly(double *V[3], fluid_t *f, grid_t *g)
+{
+    for (int c = 0; c < g->dim; c++) free(V[c]);
+    fluid_free(f);
+    grid_free(g);
+}
+
+static void test_viscous_quadratic_ghost(void **state)
+{
+    /* (a) uniform grids */
+    static const struct {
+        geom_t geom;
+        int dw;
+    } cs[4] = {{GEOM_2D, 0}, {GEOM_2D, 1}, {GEOM_3D, 2}, {GEOM_AXI, 0}};
+    for (int q = 0; q < 4; q++) {
+        poly_t pl = {.dw = cs[q].dw, .axi = cs[q].geom == GEOM_AXI, .H = 1, .U0 = 0.3, .U1 = -0.7, .c = 1.3};
+        double e[2], ew[2], sc;
+        for (int wg = 0; wg < 2; wg++) {
+            double *V[3];
+            fluid_t *f;
+            grid_t *g;
+            check_poly(cs[q].geom, cs[q].dw, STRETCH_UNIFORM, (wall_ghost_t)wg, &pl, &e[wg], &ew[wg], &sc, V, &f, &g);
+            free_poly(V, f, g);
+        }
+        /* |u''| = 2c (planar), 2b (pipe: ∂²u/∂r² = −2b), times the wall
+         * coefficient × h² (pipe: r_wall/r_c of the last cell, 32/31) */
+        double off = 0.37 * 2.0 * pl.c / 4.0 * (pl.axi ? 1.0 / (1.0 - 0.5 / 16) : 1.0);
+        msg("  quadratic profile, walls normal to %c (%s): |L u − u''| off the walls %.1e / %.1e, at the wall cells "
+            "%.1e (quadratic ghost) and %.4e (linear; ν|u''|/4 = %.4e); scale %.1e\n",
+            "xyz"[cs[q].dw], cs[q].geom == GEOM_AXI ? "pipe" : cs[q].geom == GEOM_3D ? "3-D" : "2-D", e[1], e[0], ew[1],
+            ew[0], off, sc);
+        assert_true(e[0] < 1e-12 * sc && e[1] < 1e-12 * sc && ew[1] < 1e-12 * sc);
+        assert_true(fabs(ew[0] - off) < 1e-12 * sc);
+    }
+    /* (b) stretched x walls: the wall-cell difference quadratic − linear */
+    poly_t pl = {.dw = 0, .H = 1, .U0 = 0.3, .U1 = -0.7, .c = 1.3};
+    double *V[2][3], e, ew, sc;
+    fluid_t *f[2];
+    grid_t *g[2];
+    for (int wg = 0; wg < 2; wg++)
+        check_poly(GEOM_2D, 0, STRETCH_TANH_BOTH, (wall_ghost_t)wg, &pl, &e, &ew, &sc, V[wg], &f[wg], &g[wg]);
+    const grid_t *gg = g[0];
+    double m = 0, dmax = 0;
+    int nx = gg->n[0];
+    for (int s = 0; s < 2; s++) {
+        int ig = s == 0 ? 0 : nx - 1, i = ig - gg->ix0, gc = s == 0 ? -1 : nx;
+        if (i < 0 || i >= gg->nxl) continue;
+        double xg[3] = {gg->gxc[gc], 0, 0}, U = s == 0 ? pl.U0 + 0.1 : pl.U1 - 0.2;
+        double cwall = 1.0 / (gg->gdxc[s == 0 ? -1 : nx - 1] * gg->gdxf[ig]);
+        for (int j = 0; j < gg->n[1]; j++) {
+            long idx = G_IDX(gg, i, j, 0);
+            double d = V[1][1][idx] - V[0][1][idx];
+            double want = 0.37 * cwall * (poly_fn(1, xg, 0, &pl) - (2 * U - f[0]->u[1][idx]));
+            m = fmax(m, fabs(d - want));
+            dmax = fmax(dmax, fabs(d));
+        }
+    }
+    m = grid_max(gg, m);
+    dmax = grid_max(gg, dmax);
+    msg("  stretched x walls: (L_quad − L_lin) u at the wall cells = ν c_wall (p(x_g) − 2U + u_0) to %.1e (the "
+        "difference is %.3e; scale %.1e)\n",
+        m, dmax, sc);
+    assert_true(m < 1e-12 * sc);
+    assert_true(dmax > 1e-3 * sc); /* not trivially zero */
+    for (int wg = 0; wg < 2; wg++) free_poly(V[wg], f[wg], g[wg]);
 }
 
 /* ---- bad input -------------------------------------------------------- */
@@ -504,10 +647,8 @@ static const char *base_case = "[domain]\ngeometry = %s\nnx = 8\nny = 8\nnz = %d
 
 /* Load a case, build the grid and the fluid and set the initial condition;
  * returns the error message, or "" when everything was accepted. */
-static const char *try_case(const char *geom, const char *boundary, const char *fluid)
+static const char *try_text(const char *text)
 {
-    char text[2048];
-    snprintf(text, sizeof text, base_case, geom, strcmp(geom, "3d") ? 1 : 8, boundary, fluid);
     static cfg_t *cfg;
     static grid_t *g;
     static fluid_t *f;
@@ -533,6 +674,13 @@ static const char *try_case(const char *geom, const char *boundary, const char *
     grid_free(g);
     if (cfg) cfg_free(cfg);
     return last_msg;
+}
+
+static const char *try_case(const char *geom, const char *boundary, const char *fluid)
+{
+    char text[2048];
+    snprintf(text, sizeof text, base_case, geom, strcmp(geom, "3d") ? 1 : 8, boundary, fluid);
+    return try_text(text);
 }
 
 static void expect_error(const char *geom, const char *boundary, const char *fluid, const char *needle)
@@ -568,6 +716,12 @@ static void test_bad_input(void **state)
                  "fluid.init: laminar needs exactly one wall-bounded direction");
     expect_error("2d", "y_lo = noslip\ny_hi = freeslip", "nu = 0.1\ninit = laminar",
                  "fluid.init: laminar needs no-slip walls");
+    expect_error("2d", chan, "nu = 0.1\nwall_ghost = cubic", "case.ini:12: fluid.wall_ghost: 'cubic' is not one of");
+    const char *one = "[domain]\ngeometry = 2d\nnx = 8\nny = 1\nlength = 1 1 1\n[boundary]\ny_lo = noslip\n"
+                      "y_hi = noslip\n[fluid]\nnu = 0.1\nwall_ghost = quadratic\n";
+    const char *m = try_text(one);
+    msg("  [one cell between walls] -> %s\n", m[0] ? m : "(accepted)");
+    assert_non_null(strstr(m, "case.ini:11: fluid.wall_ghost: quadratic needs at least 2 cells"));
 }
 
 int main(int argc, char **argv)
@@ -580,6 +734,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_advection_order),
         cmocka_unit_test(test_viscous_couette),
         cmocka_unit_test(test_viscous_is_poisson_operator),
+        cmocka_unit_test(test_viscous_quadratic_ghost),
         cmocka_unit_test(test_bad_input),
     };
     TEST_MPI_RUN("fluid_ops", tests);

@@ -19,6 +19,7 @@
 
 #include "config.h"
 #include "dem.h"
+#include "io.h"
 #include "porenet.h"
 #include "sim.h"
 #include "util.h"
@@ -39,9 +40,47 @@ typedef struct {
 
 static const char *const pn_cols[] = {"porenet_q_in_max", "porenet_q_out_max", "porenet_p_max", "porenet_pores"};
 
-static void read_packing(cfg_t *cfg, porenet_part_t *pp)
+/* Periodic axes: bring the centres into the box. */
+static void wrap_packing(porenet_part_t *pp)
 {
-    const char *path = cfg_string(cfg, "porenet", "packing");
+    for (int i = 0; i < pp->n; i++)
+        for (int a = 0; a < 3; a++)
+            if (pp->m.dom.periodic[a]) {
+                double L = pp->m.dom.hi[a] - pp->m.dom.lo[a];
+                double v = fmod(pp->xp[3 * i + a] - pp->m.dom.lo[a], L);
+                if (v < 0) v += L;
+                pp->xp[3 * i + a] = pp->m.dom.lo[a] + v;
+            }
+    pp->x = pp->xp;
+    pp->r = pp->rp;
+}
+
+/* An HDF5 packing (the DEM's layout, as [ibm] spheres_file reads it):
+ * datasets position [n][3] and radius [n]; the same file can then feed the
+ * resolved solver and the network (cases/permeability_crosscheck). */
+static int read_packing_h5(cfg_t *cfg, const char *path, porenet_part_t *pp)
+{
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0) cfg_fail(cfg, "porenet", "packing", "cannot open %s as HDF5", path);
+    if (H5Lexists(f, "radius", H5P_DEFAULT) <= 0 || H5Lexists(f, "position", H5P_DEFAULT) <= 0)
+        cfg_fail(cfg, "porenet", "packing", "%s: needs the datasets position [n][3] and radius [n]", path);
+    hid_t ds = H5Dopen2(f, "radius", H5P_DEFAULT), sp = H5Dget_space(ds);
+    long n = (long)H5Sget_simple_extent_npoints(sp);
+    H5Sclose(sp);
+    H5Dclose(ds);
+    pp->xp = malloc(3 * (size_t)(n + 1) * sizeof *pp->xp);
+    pp->rp = malloc((size_t)(n + 1) * sizeof *pp->rp);
+    if (io_h5_read_array(f, "radius", n, pp->rp) != n || io_h5_read_array(f, "position", 3 * n, pp->xp) != 3 * n)
+        cfg_fail(cfg, "porenet", "packing", "%s: position must hold 3 values per radius", path);
+    H5Fclose(f);
+    for (long i = 0; i < n; i++)
+        if (!(pp->rp[i] > 0)) cfg_fail(cfg, "porenet", "packing", "%s: radius %ld is not positive", path, i);
+    return (int)n;
+}
+
+/* A text packing: x y z r per line, # comments. */
+static int read_packing_text(cfg_t *cfg, const char *path, porenet_part_t *pp)
+{
     FILE *f = fopen(path, "r");
     if (!f) cfg_fail(cfg, "porenet", "packing", "cannot open %s", path);
     char line[1024];
@@ -64,19 +103,18 @@ static void read_packing(cfg_t *cfg, porenet_part_t *pp)
         n++;
     }
     fclose(f);
+    return n;
+}
+
+static void read_packing(cfg_t *cfg, porenet_part_t *pp)
+{
+    const char *path = cfg_string(cfg, "porenet", "packing");
+    size_t len = strlen(path);
+    int h5 = (len > 3 && !strcmp(path + len - 3, ".h5")) || (len > 5 && !strcmp(path + len - 5, ".hdf5"));
+    int n = h5 ? read_packing_h5(cfg, path, pp) : read_packing_text(cfg, path, pp);
     if (n < 4) cfg_fail(cfg, "porenet", "packing", "%s: %d spheres (at least 4 needed)", path, n);
     pp->n = n;
-    /* periodic axes: bring the centres into the box */
-    for (int i = 0; i < n; i++)
-        for (int a = 0; a < 3; a++)
-            if (pp->m.dom.periodic[a]) {
-                double L = pp->m.dom.hi[a] - pp->m.dom.lo[a];
-                double v = fmod(pp->xp[3 * i + a] - pp->m.dom.lo[a], L);
-                if (v < 0) v += L;
-                pp->xp[3 * i + a] = pp->m.dom.lo[a] + v;
-            }
-    pp->x = pp->xp;
-    pp->r = pp->rp;
+    wrap_packing(pp);
 }
 
 static void after_solve(porenet_part_t *pp)

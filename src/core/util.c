@@ -9,6 +9,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
+#include <time.h>
 
 int mpi_rank(void)
 {
@@ -112,6 +113,13 @@ void *xcalloc(size_t n, size_t size)
 }
 
 double wtime(void) { return MPI_Wtime(); }
+
+double cputime(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 long peak_rss_bytes(void)
 {

@@ -230,10 +230,23 @@ static void rhs_sweep(const fluid_t *f, const stage_t *st, double adt, double *c
     }
 }
 
+/* The quadratic-ghost wall terms (viscous.c) of cv·L u in H and of
+ * (dg·cv + ce)·L u in the predictor: a pass over the wall cells after the
+ * sweep (u is still u^{k−1}). */
+static void wall_ghost_terms(const fluid_t *f, double cv, double dg, double ce, double *const H[3],
+                             double *const US[3])
+{
+    for (int c = 0; c < fluid_ncomp(f->g); c++) {
+        if (H && cv != 0.0) fluid_wall_ghost_add(f, c, f->u[c], cv, H[c]);
+        if (US && dg * cv + ce != 0.0) fluid_wall_ghost_add(f, c, f->u[c], dg * cv + ce, US[c]);
+    }
+}
+
 void fluid_rhs(const fluid_t *f, double ca, double cv, double *const out[3])
 {
     stage_t st = {.ca = ca, .cv = cv, .p = f->p};
     rhs_sweep(f, &st, 0.0, out, NULL);
+    wall_ghost_terms(f, cv, 0.0, 0.0, out, NULL);
 }
 
 void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
@@ -241,6 +254,7 @@ void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double
 {
     stage_t st = {.ca = ca, .cv = cv, .dg = dg, .dz = dz, .ce = ce, .p = f->p};
     rhs_sweep(f, &st, adt, H, US);
+    wall_ghost_terms(f, cv, dg, ce, H, US);
 }
 
 void fluid_advection(const fluid_t *f, double *const out[3]) { fluid_rhs(f, 1.0, 0.0, out); }

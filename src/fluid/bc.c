@@ -12,6 +12,9 @@
  *                       homogeneous part ghost = −interior plus 2 U_wall)
  *   free-slip and axis: ghost = interior               (zero normal gradient;
  *                       on the axis u_z is even in r)
+ * These stored ghosts are the same with [fluid] wall_ghost = quadratic: the
+ * quadratic ghost enters the viscous operator only, as a wall term
+ * (viscous.c), so the face value read by everyone else is still U_wall.
  */
 #include <string.h>
 

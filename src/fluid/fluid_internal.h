@@ -5,6 +5,17 @@
 
 #include "fluid.h"
 
+/* Quadratic wall ghost (wall_ghost = quadratic) at one no-slip wall for one
+ * tangential component: the viscous operator with the quadratic ghost minus
+ * the one with the linear ghost, at the wall cell, is
+ *     c_wall (g_quad − g_lin) = kU + k0 u_0 + k1 u_1
+ * (u_0 the wall cell, u_1 its neighbour away from the wall; kU includes the
+ * wall velocity).  viscous.c sets and applies it. */
+typedef struct {
+    int on;
+    double kU, k0, k1;
+} wall_quad_t;
+
 typedef struct {
     poisson_t *pp;         /* VAR_P: projection (L = D·G) */
     poisson_t *pv[3];      /* L of each velocity location: the Crank–Nicolson Helmholtz
@@ -23,6 +34,9 @@ typedef struct {
      * wall, times 2 U_wall: the inhomogeneous part of L at the first and last
      * cell (the y and z walls are handled by the ghost values themselves) */
     double xwall[3][2];
+    /* [component][wall-normal direction][side]: the quadratic-ghost wall terms */
+    wall_quad_t wq[3][3][2];
+    int wq_any;            /* some wq[..].on */
 } fluid_priv_t;
 
 static inline fluid_priv_t *fluid_priv(const fluid_t *f) { return (fluid_priv_t *)f->priv; }
@@ -62,6 +76,7 @@ void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double
 /* viscous.c */
 void fluid_laplacian_add(const fluid_t *f, int c, const double *u, double scale, double *out);
 void fluid_wall_terms_add(const fluid_t *f, int c, double scale, double *out);
+void fluid_wall_ghost_add(const fluid_t *f, int c, const double *u, double scale, double *out);
 void fluid_viscous_setup(fluid_t *f);
 /* bc.c */
 void fluid_fill_pressure_ghosts(const fluid_t *f, double *p);

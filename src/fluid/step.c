@@ -146,8 +146,16 @@ void fluid_project(fluid_t *f)
 }
 
 /* Crank–Nicolson: u[c] holds the explicit part rhs = u* of the predictor;
- * solve (I − αΔtν/2 L) u* = rhs  ⇔  (L_hom − λ) u* = −λ rhs − wall terms. */
-static void helmholtz_component(fluid_t *f, int c, double adt)
+ * solve (I − αΔtν/2 L) u* = rhs  ⇔  (L_hom − λ) u* = −λ rhs − wall terms.
+ * With the quadratic wall ghost, L = L_lin + C where the solvers carry L_lin
+ * only (the transforms need ghost = ±interior); C u* goes to the right-hand
+ * side, evaluated at u^{k−1} (u_prev) for a first solve, then at that
+ * solution for a second one.  The steady state satisfies the quadratic
+ * discretisation exactly either way; the second solve is for stability: with
+ * C lagged once, a step amplifies the wall modes for νΔt/Δ² > 8.3 (1-D
+ * eigenvalue analysis, docs/theory.md §4.3); with two solves (an even number)
+ * every νΔt/Δ² is stable. */
+static void helmholtz_component(fluid_t *f, int c, double adt, const double *u_prev)
 {
     const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
@@ -158,8 +166,16 @@ static void helmholtz_component(fluid_t *f, int c, double adt)
         FLUID_FOR_LINES(g, i, nj, nk, c0, len)
         for (long m = c0; m < c0 + len; m++) w[m] = -lam * u[m];
     fluid_wall_terms_add(f, c, -1.0, w);
-    if (poisson_solve(q->pv[c], lam, w, u) != 0)
-        warn("step %ld: the Helmholtz solve of component %c did not converge\n", f->step, "uvw"[c]);
+    fluid_wall_ghost_add(f, c, u_prev, -1.0, w);
+    int fail = poisson_solve(q->pv[c], lam, w, u) != 0;
+    if (q->wq_any) {
+        /* the x-wall neighbour u_1 may be on the next rank */
+        if (!g->periodic[0] && g->nxl < 2) grid_halo_x(g, u);
+        fluid_wall_ghost_add(f, c, u_prev, 1.0, w);
+        fluid_wall_ghost_add(f, c, u, -1.0, w);
+        fail |= poisson_solve(q->pv[c], lam, w, u) != 0;
+    }
+    if (fail) warn("step %ld: the Helmholtz solve of component %c did not converge\n", f->step, "uvw"[c]);
 }
 
 void fluid_step(fluid_t *f, double dt)
@@ -187,7 +203,7 @@ void fluid_step(fluid_t *f, double dt)
             q->spare[c] = old;
         }
         if (impl)
-            for (int c = 0; c < nc; c++) helmholtz_component(f, c, adt);
+            for (int c = 0; c < nc; c++) helmholtz_component(f, c, adt, q->spare[c] /* u^{k−1} */);
         fluid_apply_bc(f);
         if (f->stage_hook) {
             f->stage_hook(f, s, adt, f->hook_ctx);

@@ -10,28 +10,78 @@
  * gets + c_wall · 2U, c_wall being the coefficient the ghost would have had.
  * In y and z the stencil is applied to the true ghosts (bc.c), which already
  * hold 2U − interior.
+ *
+ * wall_ghost = quadratic (docs/theory.md §4.3): the ghost of a tangential
+ * component at a no-slip wall is instead the value at the ghost centre of the
+ * parabola through the wall value U (distance 0), u_0 (d_0) and u_1 (d_1):
+ * at distance −d_g,
+ *     g_quad = a_U U + a_0 u_0 + a_1 u_1,
+ *     a_U = (d_g+d_0)(d_g+d_1)/(d_0 d_1),  a_0 = −d_g(d_g+d_1)/(d_0(d_1−d_0)),
+ *     a_1 = d_g(d_g+d_0)/(d_1(d_1−d_0))
+ * (uniform: 8/3, −2, 1/3), exact for quadratic profiles on stretched grids
+ * too.  The stored ghosts stay linear (bc.c: the face value, mean of ghost
+ * and interior, is the wall velocity for every other reader); the operator
+ * adds c_wall (g_quad − g_lin) at the wall cells (fluid_wall_ghost_add).
  */
 #include <string.h>
 
 #include "fluid_internal.h"
 
+/* Coefficient of the ghost of a cell-centred x unknown at the x wall s in
+ * the row of the wall cell (flux through the wall face / cell volume, as in
+ * poisson_create: w at i = 0, e at i = nx−1). */
+static double x_wall_coef(const grid_t *g, int s)
+{
+    int nx = g->n[0], axi = g->geom == GEOM_AXI;
+    int i = s == 0 ? 0 : nx - 1, fw = s == 0 ? -1 : nx - 1, cc = s == 0 ? -1 : nx - 1;
+    double a_face = axi ? g->gxf[fw] : 1.0, vol = (axi ? g->gxc[i] : 1.0) * g->gdxf[i];
+    return a_face / (g->gdxc[cc] * vol);
+}
+
+/* The quadratic-ghost wall term of component c at the no-slip wall (d, s):
+ * distances from the wall of the first two cell centres (d0, d1) and of the
+ * ghost centre (dg), and the coefficient c_wall of the ghost in the row. */
+static wall_quad_t wall_quad_setup(const grid_t *g, int c, int d, int s)
+{
+    double d0, d1, dg, cw;
+    if (d == 0) {
+        int nx = g->n[0];
+        if (s == 0) {
+            double xw = g->gxf[-1];
+            d0 = g->gxc[0] - xw, d1 = g->gxc[1] - xw, dg = xw - g->gxc[-1];
+        } else {
+            double xw = g->gxf[nx - 1];
+            d0 = xw - g->gxc[nx - 1], d1 = xw - g->gxc[nx - 2], dg = g->gxc[nx] - xw;
+        }
+        cw = x_wall_coef(g, s);
+    } else {
+        double h = d == 1 ? g->dy : g->dz;
+        d0 = 0.5 * h, d1 = 1.5 * h, dg = 0.5 * h;
+        cw = 1.0 / (h * h);
+    }
+    double aU = (dg + d0) * (dg + d1) / (d0 * d1), a0 = -dg * (dg + d1) / (d0 * (d1 - d0)),
+           a1 = dg * (dg + d0) / (d1 * (d1 - d0));
+    /* minus the linear ghost 2U − u_0 */
+    return (wall_quad_t){.on = 1, .kU = cw * (aU - 2.0) * g->bc.vel[d][s][c], .k0 = cw * (a0 + 1.0), .k1 = cw * a1};
+}
+
 void fluid_viscous_setup(fluid_t *f)
 {
     const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
-    int nx = g->n[0], axi = g->geom == GEOM_AXI;
     memset(q->xwall, 0, sizeof q->xwall);
-    if (g->periodic[0]) return;
-    for (int c = 1; c < fluid_ncomp(g); c++)
-        for (int s = 0; s < 2; s++) {
-            if (g->bc.type[0][s] != BC_NOSLIP) continue;
-            /* cell-centred in x: flux through the wall face / cell volume, as in
-             * poisson_create (w at i = 0, e at i = nx−1) */
-            int i = s == 0 ? 0 : nx - 1, fw = s == 0 ? -1 : nx - 1, cc = s == 0 ? -1 : nx - 1;
-            double a_face = axi ? g->gxf[fw] : 1.0, vol = (axi ? g->gxc[i] : 1.0) * g->gdxf[i];
-            double coef = a_face / (g->gdxc[cc] * vol);
-            q->xwall[c][s] = 2.0 * g->bc.vel[0][s][c] * coef;
-        }
+    memset(q->wq, 0, sizeof q->wq);
+    q->wq_any = 0;
+    for (int c = 0; c < fluid_ncomp(g); c++)
+        for (int d = 0; d < g->dim; d++)
+            for (int s = 0; s < 2; s++) {
+                if (d == c || g->periodic[d] || g->bc.type[d][s] != BC_NOSLIP) continue;
+                if (d == 0) q->xwall[c][s] = 2.0 * g->bc.vel[0][s][c] * x_wall_coef(g, s);
+                if (f->prm.wall_ghost == WALL_GHOST_QUADRATIC) {
+                    q->wq[c][d][s] = wall_quad_setup(g, c, d, s);
+                    q->wq_any = 1;
+                }
+            }
 }
 
 /* out += scale · L u_c on the unknowns of component c, u with true ghosts. */
@@ -64,6 +114,7 @@ void fluid_laplacian_add(const fluid_t *f, int c, const double *u, double scale,
             }
         }
     }
+    fluid_wall_ghost_add(f, c, u, scale, out);
 }
 
 /* out += scale · (inhomogeneous wall part of L u_c): what the true operator
@@ -91,6 +142,41 @@ void fluid_wall_terms_add(const fluid_t *f, int c, double scale, double *out)
                 out[G_IDX(g, i, j, k)] += scale * w;
             }
     }
+}
+
+/* out += scale · (L_quad − L_lin) u_c at the wall cells of the no-slip walls
+ * tangential to c (nothing with wall_ghost = linear).  u needs valid ghost
+ * planes in x where the neighbour u_1 of an x-wall cell lies on the next
+ * rank (one cell per rank). */
+void fluid_wall_ghost_add(const fluid_t *f, int c, const double *u, double scale, double *out)
+{
+    const fluid_priv_t *q = fluid_priv(f);
+    if (!q->wq_any) return;
+    const grid_t *g = f->g;
+    int iend = fluid_iend(g, c), nj = fluid_nu(g, c, 1), nk = fluid_nu(g, c, 2);
+    for (int d = 0; d < g->dim; d++)
+        for (int s = 0; s < 2; s++) {
+            const wall_quad_t *w = &q->wq[c][d][s];
+            if (!w->on) continue;
+            /* the wall cell's range: the plane index along d fixed */
+            int lo[3] = {0, 0, 0}, hi[3] = {iend, nj, nk};
+            long nb; /* offset of u_1 from u_0 */
+            if (d == 0) {
+                int i = (s == 0 ? 0 : g->n[0] - 1) - g->ix0;
+                if (i < 0 || i >= g->nxl) continue;
+                lo[0] = i, hi[0] = i + 1, nb = s == 0 ? g->sx : -g->sx;
+            } else {
+                int m = s == 0 ? 0 : g->n[d] - 1;
+                lo[d] = m, hi[d] = m + 1, nb = d == 1 ? (s == 0 ? g->sy : -g->sy) : (s == 0 ? 1 : -1);
+            }
+            double a = scale * w->kU, b0 = scale * w->k0, b1 = scale * w->k1;
+            for (int i = lo[0]; i < hi[0]; i++)
+                for (int j = lo[1]; j < hi[1]; j++)
+                    for (int k = lo[2]; k < hi[2]; k++) {
+                        long m = G_IDX(g, i, j, k);
+                        out[m] += a + b0 * u[m] + b1 * u[m + nb];
+                    }
+        }
 }
 
 void fluid_viscous(const fluid_t *f, double *const out[3])
