@@ -43,7 +43,17 @@ static inline double linear_normal(const dem_contact_prm_t *cp, double delta, do
     return kn * delta - meff * cp->gn_rel * vn_damp;
 }
 
+/* K = k_n/m*: the force k_n max(δ, 0) has a kink of this stiffness (per
+ * unit effective mass) at δ = 0, which the kernel treats at the first and the
+ * last step of a contact ([contact] spring_kink, docs/theory.md §7.7). */
+static inline double linear_kink(const dem_contact_prm_t *cp, double meff, double imeff)
+{
+    (void)meff;
+    return cp->kn_abs * imeff + cp->kn_rel;
+}
+
 #define LAW_NORMAL linear_normal
+#define LAW_KINK linear_kink
 #define LAW_PAIRS linear_pairs
 #define LAW_WALL linear_wall
 #include "dem_kernel.inc"
@@ -112,6 +122,14 @@ static void calibrate_clipped(double e, double tc, double *K, double *G)
     }
 }
 
+/* The onset/separation weights of the spring (dem_kernel.inc) where the
+ * force keeps its kink at δ = 0 at both ends: unclipped, or without damping
+ * (a clipped law with damping lets go before δ = 0, at the clip). */
+static void linear_kink_setup(dem_contact_prm_t *cp, cfg_t *cfg)
+{
+    cp->kink_energy = cfg_enum(cfg, "contact", "spring_kink") == 0 && (!cp->clip || cp->gn_rel == 0.0);
+}
+
 static void linear_setup(dem_t *d, cfg_t *cfg)
 {
     dem_contact_prm_t *cp = &d->cp;
@@ -124,6 +142,7 @@ static void linear_setup(dem_t *d, cfg_t *cfg)
         cp->restitution = cp->tc_given = 0.0;
         snprintf(cp->summary, sizeof cp->summary, "linear contact, k_n = %.6g N/m, gamma_n/m* = %.6g s^-1, k_t/k_n = %g%s",
                  cp->kn_abs, cp->gn_rel, cp->kt_ratio, cp->clip ? " (normal force clipped)" : "");
+        linear_kink_setup(cp, cfg);
         return;
     }
     const double e = cfg_double(cfg, "contact", "restitution");
@@ -141,6 +160,7 @@ static void linear_setup(dem_t *d, cfg_t *cfg)
                      "'clipped' calibrates the clipped law; with normal_clip = false use calibration = seed");
         calibrate_clipped(e, tc, &cp->kn_rel, &cp->gn_rel);
     }
+    linear_kink_setup(cp, cfg);
     double dur, eeff;
     linear_oscillator(cp->kn_rel, cp->gn_rel, cp->clip, &dur, &eeff);
     snprintf(cp->summary, sizeof cp->summary,

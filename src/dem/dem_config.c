@@ -61,6 +61,9 @@ static const cfg_key_t dem_keys[] = {
      "linear: k_n, gamma_n such that the clipped law gives exactly e_dry and t_c (clipped), or eq. 3.16-3.17 "
      "of the seed (exact for the unclipped law)"},
     {"contact", "normal_clip", CFG_BOOL, "true", 1, 0, NULL, "normal force clipped at zero (no attraction)"},
+    {"contact", "spring_kink", CFG_ENUM, "energy", 1, 0, "energy|plain",
+     "linear: first and last step of a contact weighted so that velocity Verlet keeps the energy across the kink "
+     "of k_n max(delta, 0) (docs/theory.md 7.7; unclipped or undamped contacts); plain: no weight"},
     {"contact", "kn", CFG_DOUBLE, NULL, 0, BIG, NULL, "linear, parameters = stiffness: normal stiffness (N/m)"},
     {"contact", "gamma_n", CFG_DOUBLE, "0", 0, BIG, NULL,
      "linear, parameters = stiffness: normal damping per unit effective mass (1/s)"},

@@ -63,6 +63,8 @@ typedef struct {
     double mu_roll;      /* rolling resistance coefficient (constant torque), 0 = off */
     /* linear spring–dashpot: F_n = (kn_abs + m* kn_rel) δ + m* gn_rel δ̇ */
     double kn_abs, kn_rel, gn_rel;
+    int kink_energy;     /* linear: onset/separation weights of the spring (theory §7.7), where
+                            the force has its kink at δ = 0 (unclipped or undamped) */
     double restitution, tc_given;
     /* Hertz–Mindlin */
     double E_star, G_star, beta_damp, v_ref;
