@@ -15,6 +15,12 @@
  *     solution at T_v = C_v t/L² = 0.1, 0.2, 0.5, 1 with C_v = κ E_oed/μ.
  *     §5.4 asks ±0.05 (PN_TOL=0.05 in scripts/validate.sh, full column);
  *     make test bounds the coarse column by its measured deviation.
+ *  5. the settlement corrected for the initial compression (Taylor's √t
+ *     method, ASTM D2435): the straight part of U against √T_v, fitted on
+ *     TAYLOR_LO ≤ T_v ≤ TAYLOR_HI and extrapolated to t = 0, gives the
+ *     corrected zero d_s/ΔH; U_corr = (U − d_s/ΔH)/(1 − d_s/ΔH).  The ±0.05
+ *     bound applies to p_mid, p_base and U_corr; the raw U is printed and
+ *     bounded separately (docs/validation.md).
  * Heights and settlements are those of the centres of the grains touching
  * the piston: the piston's own contacts, at the drained face, would add a
  * compliance that drains at once (not Terzaghi's).
@@ -35,8 +41,18 @@
 #include "util.h"
 
 static const double TV[4] = {0.1, 0.2, 0.5, 1.0};
-/* bound on the deviation from the series of the coarse case (see the end of test_consolidation) */
-#define COARSE_TOL 0.10
+/* bound on the deviation from the series of the coarse case (p_mid, p_base, U_corr; see the end
+ * of test_consolidation): measured 0.066 (p_base at T_v = 0.5) + 0.02 */
+#define COARSE_TOL 0.09
+/* bound on the deviation of the raw (uncorrected) U of the coarse case: measured 0.083 (T_v = 0.1) + 0.02 */
+#define COARSE_RAW_TOL 0.10
+/* Taylor's √t construction: the window of the straight line.  Terzaghi's U is
+ * 2 √(T_v/π) to 2·10⁻⁴ up to T_v = 0.2 (U ≈ 0.5); from T_v = 0.02 on the
+ * immediate compression of the layer under the piston is over (600 spheres:
+ * U/√T_v peaks at T_v ≈ 0.002 and the line fits U on [0.02, 0.2] within 0.003).
+ * The window ends at 0.2 so that the reference runs (PN_TV_MAX=0.2) have it. */
+#define TAYLOR_LO 0.02
+#define TAYLOR_HI 0.2
 
 /* Terzaghi's series (catalano_pfv.md §2.2), drained face at z = L, sealed
  * base at z = 0 (the drainage path L = H), M = (2m+1)π/2:
@@ -167,6 +183,8 @@ static double band_pressure(const pn_model_t *m, double zlo, double zhi, double 
 
 typedef struct {
     double pmid[4], pbase[4], U[4];
+    double ds;          /* Taylor's corrected zero d_s/ΔH (0 if the window was not reached) */
+    double taylor_slope; /* dU/d√T_v of the straight part (Terzaghi: 2/√π ≈ 1.128) */
     double zmid, zbase; /* mean heights of the pores of the two bands */
     double pmax;        /* largest p_mid/Δσ seen */
     long steps, retri;
@@ -200,6 +218,7 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
         printf("# wet: dt %.3g s (viscous limit x dt_factor %.3g, DEM %.3g)\n", dt, pn_coupled_dt(&m, d), dem_dt(d));
     const double t0 = dem_time(d), w0 = cpu_time();
     int next = 0;
+    double sx = 0, sy = 0, sxx = 0, sxy = 0, sn = 0; /* least squares of U on √T_v, Taylor's window */
     /* PN_STEPS: stop after this many steps (timing runs) */
     const long max_steps = getenv("PN_STEPS") ? atol(getenv("PN_STEPS")) : -1;
     /* PN_TV_MAX: stop after the last T_v of the list not above it (reference runs) */
@@ -217,6 +236,10 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
         const double pm = band_pressure(&m, 0.45 * H, 0.55 * H, &w.zmid) / dsig;
         const double pb = band_pressure(&m, -1, 0.1 * H, &w.zbase) / dsig, U = (z0 - surface_z(d, o)) / dH;
         w.pmax = fmax(w.pmax, pb);
+        if (T >= TAYLOR_LO && T <= TAYLOR_HI) {
+            const double x = sqrt(T);
+            sx += x, sy += U, sxx += x * x, sxy += x * U, sn++;
+        }
         if (series && w.steps % 20 == 0)
             fprintf(series, "%s,%.6g,%.6g,%.6g,%.6g,%.4f,%.4f\n", label, T, pm, pb, U, w.zmid / L, w.zbase / L);
         if (getenv("PN_TRACE") && w.steps % 100 == 0 && mpi_rank() == 0)
@@ -246,6 +269,10 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
             w.U[next] = U;
             next++;
         }
+    }
+    if (sn >= 2) {
+        w.taylor_slope = (sn * sxy - sx * sy) / (sn * sxx - sx * sx);
+        w.ds = (sy - w.taylor_slope * sx) / sn;
     }
     w.t_step = (cpu_time() - w0) / w.steps;
     w.ntv = next;
@@ -399,20 +426,26 @@ static void test_consolidation(void **state)
         printf("#   drainage path L = %.4g m (drained face from the permeameter; L/H = %.4f), T_v = C_v t/L^2; bands: "
                "mid-height z/L = %.3f, base z/L = %.3f\n",
                L, zdrain / H, w.zmid / L, w.zbase / L);
+        printf("#   Taylor (U against sqrt(T_v) on %.2g <= T_v <= %.2g): corrected zero d_s = %.4f dH, slope %.4f "
+               "(Terzaghi 2/sqrt(pi) = %.4f; x (1 - d_s) = %.4f)\n",
+               TAYLOR_LO, TAYLOR_HI, w.ds, w.taylor_slope, 2 / sqrt(M_PI), 2 / sqrt(M_PI) * (1 - w.ds));
         for (int k = 0; k < w.ntv; k++)
-            printf("#   T_v = %.1f: p_mid/dsigma = %.4f (Terzaghi %.4f), p_base/dsigma = %.4f (Terzaghi %.4f), U = %.4f "
-                   "(Terzaghi %.4f)\n",
+            printf("#   T_v = %.1f: p_mid/dsigma = %.4f (Terzaghi %.4f), p_base/dsigma = %.4f (Terzaghi %.4f), U = %.4f, "
+                   "U_corr = %.4f (Terzaghi %.4f)\n",
                    TV[k], w.pmid[k], terzaghi_p(w.zmid / L, TV[k]), w.pbase[k], terzaghi_p(w.zbase / L, TV[k]), w.U[k],
-                   terzaghi_U(TV[k]));
+                   (w.U[k] - w.ds) / (1 - w.ds), terzaghi_U(TV[k]));
     }
-    double dev = 0; /* largest deviation from the series */
+    double dev = 0;     /* largest deviation from the series: p_mid, p_base, U_corr */
+    double dev_raw = 0; /* that of the raw U (settlement from the instant of loading) */
     const int ntv = w.ntv;
     for (int k = 0; k < ntv; k++) {
         dev = fmax(dev, fabs(w.pmid[k] - terzaghi_p(w.zmid / L, TV[k])));
         dev = fmax(dev, fabs(w.pbase[k] - terzaghi_p(w.zbase / L, TV[k])));
-        dev = fmax(dev, fabs(w.U[k] - terzaghi_U(TV[k])));
+        dev = fmax(dev, fabs((w.U[k] - w.ds) / (1 - w.ds) - terzaghi_U(TV[k])));
+        dev_raw = fmax(dev_raw, fabs(w.U[k] - terzaghi_U(TV[k])));
     }
-    if (mpi_rank() == 0) printf("# largest deviation from Terzaghi: %.4f\n", dev);
+    if (mpi_rank() == 0)
+        printf("# largest deviation from Terzaghi: %.4f (p_mid, p_base, U_corr); raw U: %.4f\n", dev, dev_raw);
     double worst = 0;
     if (getenv("PN_REFERENCE")) {
         const wet_t e = run_wet(cfg, s0, &o, hnet, sigma0, dsig, H, L, dH, cv, 0.0, series, "every_step");
@@ -439,6 +472,11 @@ static void test_consolidation(void **state)
      * set-up against regressions, not Terzaghi's accuracy */
     const double tol = getenv("PN_TOL") ? atof(getenv("PN_TOL")) : COARSE_TOL;
     assert_true(dev < tol);
+    /* the corrected zero is an immediate compression: positive, and a minor part of ΔH
+     * (measured 0.10 on 600 spheres); 0 would mean the window was not reached */
+    if (ntv >= 2) assert_true(w.ds > 0 && w.ds < 0.3);
+    /* the raw U (the immediate compression included) of the coarse column: a regression bound */
+    if (!getenv("PN_TOL")) assert_true(dev_raw < COARSE_RAW_TOL);
     /* §5.4: the default criterion agrees with every-step re-triangulation within 2 % */
     assert_true(worst < 0.02);
     if (mpi_rank() == 0) {
