@@ -107,6 +107,13 @@ double *dem_ext_force(dem_t *d);
 double *dem_ext_torque(dem_t *d);
 /* Total contact force of each particle (pairs and walls) at the last step. */
 const double *dem_contact_forces(const dem_t *d);
+/* Particle i is in contact: it carries a nonzero contact force (pairs or
+ * walls) at the last step; used by the coupling's freeze and measurements. */
+static inline int dem_in_contact(const dem_t *d, int i)
+{
+    const double *f = dem_contact_forces(d) + 3 * i;
+    return f[0] != 0 || f[1] != 0 || f[2] != 0;
+}
 
 /* Brenner lubrication (lubrication.c), set by [lubrication] in a case file. */
 void dem_lubrication_register_keys(void);

@@ -52,7 +52,7 @@ void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const 
                             coupling_freeze_t *fz, double dt)
 {
     double *fe = dem_ext_force(d), *te = dem_ext_torque(d);
-    const double *r = dem_radii(d), *fc = dem_contact_forces(d);
+    const double *r = dem_radii(d);
     const long *id = dem_ids(d);
     for (int i = 0; i < dem_count(d); i++) {
         const long p = id[i];
@@ -60,7 +60,7 @@ void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const 
         const double V = 4.0 / 3.0 * M_PI * r[i] * r[i] * r[i];
         double F[6] = {s->force[0], s->force[1], s->force[2], s->torque[0], s->torque[1], s->torque[2]};
         if (fz) {
-            const int contact = fc[3 * i] != 0 || fc[3 * i + 1] != 0 || fc[3 * i + 2] != 0;
+            const int contact = dem_in_contact(d, i);
             double *F0 = fz->F0 + 6 * p, *J = fz->J + 6 * p;
             if (contact && fz->held[p] < fz->hold_time) {
                 /* frozen: the force before the contact; what the fluid did meanwhile is deferred */
@@ -86,7 +86,6 @@ void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const 
         }
     }
 }
-
 
 void coupling_motion_to_ibm(const dem_t *d, ibm_t *ibm)
 {

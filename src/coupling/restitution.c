@@ -109,9 +109,8 @@ void restitution_substep(restitution_t *r, dem_t *d)
     double dir[3];
     approach_direction(r, d, i, j, dir);
     const double u = approach_speed(r, d, i, j, dir, 1);
-    /* a contact is on while particle 0 carries a contact force (clipped normal force) */
-    const double *fc = dem_contact_forces(d) + 3 * i, *fl = dem_lubrication_forces(d) + 3 * i;
-    const int c = fc[0] != 0 || fc[1] != 0 || fc[2] != 0;
+    const double *fl = dem_lubrication_forces(d) + 3 * i;
+    const int c = dem_in_contact(d, i);
     /* lubrication impulse on particle 0 against its approach direction: positive when it
      * pushes the particle back */
     r->lub_impulse -= dem_dt(d) * (fl[0] * dir[0] + fl[1] * dir[1] + fl[2] * dir[2]);
