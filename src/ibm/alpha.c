@@ -542,18 +542,14 @@ void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
 
 void ibm_solid_fraction_face(const ibm_t *ibm, int c, double *out)
 {
+    /* min(1, Σ_p α_p) of each forced node: node_asum, summed by the build */
     const ibm_priv_t *q = ibm_priv(ibm);
     field_zero(ibm->g, out);
-    for (long r = 0; r < q->nruns; r++) {
-        const ibm_run_t *run = &q->runs[r];
-        if (run->c != c) continue;
-        for (int k = 0; k < run->len; k++) out[run->m0 + k * q->rstride] += q->alpha[run->a0 + k];
-    }
-    for (long r = 0; r < q->nruns; r++) {
-        const ibm_run_t *run = &q->runs[r];
-        if (run->c != c) continue;
-        for (int k = 0; k < run->len; k++)
-            if (out[run->m0 + k * q->rstride] > 1.0) out[run->m0 + k * q->rstride] = 1.0;
+    for (long r = 0; r < q->n_nruns; r++) {
+        const ibm_node_run_t *nr = &q->nruns_f[r];
+        if (nr->c != c) continue;
+        const double *A = q->node_asum + nr->n0;
+        for (int k = 0; k < nr->len; k++) out[nr->m0 + k * q->rstride] = A[k] < 1.0 ? A[k] : 1.0;
     }
 }
 

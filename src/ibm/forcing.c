@@ -280,6 +280,11 @@ static void displacement(const grid_t *g, const double a[3], const double b[3], 
     }
 }
 
+/* Fixed and external spheres do not move within a fluid step: an external
+ * one is moved between steps only (by the coupling), and its α stays
+ * where it was put over the three stages. */
+static inline int still_within_step(const ibm_sphere_t *s) { return s->kind == IBM_FIXED || s->kind == IBM_EXTERNAL; }
+
 /* Do all spheres keep their position and velocity over the fluid step
  * (fixed spheres, and external ones, which the coupling moves between
  * steps)?  Then the solid fraction and the targets Ū stay as they are over
@@ -290,7 +295,7 @@ static void displacement(const grid_t *g, const double a[3], const double b[3], 
 static int step_frozen(const ibm_t *ibm)
 {
     for (int p = 0; p < ibm->n; p++)
-        if (ibm->s[p].kind != IBM_FIXED && ibm->s[p].kind != IBM_EXTERNAL) return 0;
+        if (!still_within_step(&ibm->s[p])) return 0;
     return 1;
 }
 
@@ -316,7 +321,7 @@ static int carry_external_moves(ibm_t *ibm)
     char *mv = xcalloc((size_t)ibm->n, 1);
     for (int p = 0; p < ibm->n; p++) {
         ibm_sphere_t *s = &ibm->s[p];
-        if ((s->kind != IBM_FIXED && s->kind != IBM_EXTERNAL) || !memcmp(s->xa, s->x, sizeof s->x)) continue;
+        if (!still_within_step(s) || !memcmp(s->xa, s->x, sizeof s->x)) continue;
         double dx[3], dp[3], *I = q->mom_prev + 6 * p, *L = I + 3, dd = 0, dpd = 0;
         displacement(ibm->g, s->xa, s->x, dx);
         displacement(ibm->g, s->xa, s->xpred, dp);
@@ -370,7 +375,7 @@ void ibm_update_geometry(ibm_t *ibm)
     for (int p = 0; p < ibm->n; p++) memcpy(ibm->s[p].xa, ibm->s[p].x, sizeof ibm->s[p].x);
     ibm_rebuild_geometry(ibm);
     for (int p = 0; p < ibm->n; p++)
-        if (ibm->s[p].kind == IBM_FIXED || ibm->s[p].kind == IBM_EXTERNAL)
+        if (still_within_step(&ibm->s[p]))
             memcpy(q->mom_prev + 6 * p, keep + 6 * p, 6 * sizeof(double));
     free(keep);
 }
@@ -464,7 +469,7 @@ static void update_sphere(ibm_t *ibm, int p, double dt, double t_end, double J[3
     memcpy(w0, s->omega, sizeof w0);
     /* the reference point of L moves with the solid fraction: not so for
      * fixed and external spheres, whose α stays where it is over the step */
-    double dt_ref = s->kind == IBM_FIXED || s->kind == IBM_EXTERNAL ? 0.0 : dt;
+    double dt_ref = still_within_step(s) ? 0.0 : dt;
     for (int c = 0; c < 3; c++) {
         J[c] = rho * (sum[IBM_MOM + c] - prev[c] - sum[IBM_FIMP + c]);
         K[c] = rho * (sum[IBM_ANG + c] - prev[3 + c] + dt_ref * uxI[c] - sum[IBM_TIMP + c]);
