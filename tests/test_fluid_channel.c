@@ -271,7 +271,8 @@ static void test_hagen_poiseuille(void **state)
     }
 }
 
-/* Stability with the quadratic wall ghost (docs/theory.md §4.5).  Walls in
+/* Stability with the quadratic wall ghost (docs/theory.md §4.5 explicit,
+ * §4.3 Crank–Nicolson).  Walls in
  * y (16 cells, ν/Δy² = 256), x nearly inert (4 cells over 4, ν/Δx² = 1), an
  * x-uniform field u(y) = (−1)^j: divergence-free and not advected, so only
  * the viscous term acts, and it holds the wall-localised mode of largest
