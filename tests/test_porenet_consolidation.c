@@ -30,7 +30,6 @@
  */
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "config.h"
@@ -108,25 +107,18 @@ static double surface_z(const dem_t *d, const oedo_t *o)
     return h / o->ntop;
 }
 
-/* CPU time of this process: the machine is shared, the wall time of a step
- * depends on the other jobs, the CPU time much less */
-static double cpu_time(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-    return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-/* CPU time and count of the dry DEM steps (the cost of a coupled step is
- * reported relative to a dry one of the same packing) */
+/* CPU time (cputime(): the machine is shared, the wall time of a step
+ * depends on the other jobs, the CPU time much less) and count of the dry DEM
+ * steps (the cost of a coupled step is reported relative to a dry one of the
+ * same packing) */
 static double dry_time;
 static long dry_steps;
 
 static void dry_steps_run(dem_t *d, long n)
 {
-    const double t0 = cpu_time();
+    const double t0 = cputime();
     assert_int_equal(dem_run_steps(d, n), DEM_OK);
-    dry_time += cpu_time() - t0;
+    dry_time += cputime() - t0;
     dry_steps += n;
 }
 
@@ -216,7 +208,7 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
     w.dt = dt;
     if (getenv("PN_TRACE") && mpi_rank() == 0)
         printf("# wet: dt %.3g s (viscous limit x dt_factor %.3g, DEM %.3g)\n", dt, pn_coupled_dt(&m, d), dem_dt(d));
-    const double t0 = dem_time(d), w0 = cpu_time();
+    const double t0 = dem_time(d), w0 = cputime();
     int next = 0;
     double sx = 0, sy = 0, sxx = 0, sxy = 0, sn = 0; /* least squares of U on √T_v, Taylor's window */
     /* PN_STEPS: stop after this many steps (timing runs) */
@@ -274,7 +266,7 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
         w.taylor_slope = (sn * sxy - sx * sy) / (sn * sxx - sx * sx);
         w.ds = (sy - w.taylor_slope * sx) / sn;
     }
-    w.t_step = (cpu_time() - w0) / w.steps;
+    w.t_step = (cputime() - w0) / w.steps;
     w.ntv = next;
     free(zinit);
     w.retri = m.n_retri;
