@@ -178,7 +178,7 @@ typedef struct {
     double ds;          /* Taylor's corrected zero d_s/ΔH (0 if the window was not reached) */
     double taylor_slope; /* dU/d√T_v of the straight part (Terzaghi: 2/√π ≈ 1.128) */
     double zmid, zbase; /* mean heights of the pores of the two bands */
-    double pmax;        /* largest p_mid/Δσ seen */
+    double pmax;        /* largest p_base/Δσ seen (the undrained jump) */
     long steps, retri;
     double t_step;      /* CPU time per coupled step (DEM + network) */
     double dt;
