@@ -83,6 +83,13 @@ void io_h5_write_array(hid_t loc, const char *name, long n, const double *v);
 void io_h5_write_matrix(hid_t loc, const char *name, long n, int m, const double *v);
 /* Returns the number of values read (<= nmax; n×m for a matrix), or -1 if missing. */
 long io_h5_read_array(hid_t loc, const char *name, long nmax, double *v);
+/* A sphere packing file (the DEM's layout: datasets position [n][3] and
+ * radius [n], optional others): 1 if path names an HDF5 file (.h5, .hdf5). */
+int io_is_h5_path(const char *path);
+/* Opens it read-only and returns the file with *n the number of spheres;
+ * a file that cannot be opened or lacks position/radius stops the run with
+ * cfg_fail(cfg, section, key, ...). */
+hid_t io_h5_open_packing(cfg_t *cfg, const char *section, const char *key, const char *path, long *n);
 void io_h5_write_text(hid_t loc, const char *name, const char *text);
 char *io_h5_read_text(hid_t loc, const char *name); /* malloc'd; NULL if missing */
 void io_h5_attr_double(hid_t loc, const char *name, double v);

@@ -60,14 +60,8 @@ static void wrap_packing(porenet_part_t *pp)
  * resolved solver and the network (cases/permeability_crosscheck). */
 static int read_packing_h5(cfg_t *cfg, const char *path, porenet_part_t *pp)
 {
-    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-    if (f < 0) cfg_fail(cfg, "porenet", "packing", "cannot open %s as HDF5", path);
-    if (H5Lexists(f, "radius", H5P_DEFAULT) <= 0 || H5Lexists(f, "position", H5P_DEFAULT) <= 0)
-        cfg_fail(cfg, "porenet", "packing", "%s: needs the datasets position [n][3] and radius [n]", path);
-    hid_t ds = H5Dopen2(f, "radius", H5P_DEFAULT), sp = H5Dget_space(ds);
-    long n = (long)H5Sget_simple_extent_npoints(sp);
-    H5Sclose(sp);
-    H5Dclose(ds);
+    long n;
+    hid_t f = io_h5_open_packing(cfg, "porenet", "packing", path, &n);
     pp->xp = malloc(3 * (size_t)(n + 1) * sizeof *pp->xp);
     pp->rp = malloc((size_t)(n + 1) * sizeof *pp->rp);
     if (io_h5_read_array(f, "radius", n, pp->rp) != n || io_h5_read_array(f, "position", 3 * n, pp->xp) != 3 * n)
@@ -109,8 +103,7 @@ static int read_packing_text(cfg_t *cfg, const char *path, porenet_part_t *pp)
 static void read_packing(cfg_t *cfg, porenet_part_t *pp)
 {
     const char *path = cfg_string(cfg, "porenet", "packing");
-    size_t len = strlen(path);
-    int h5 = (len > 3 && !strcmp(path + len - 3, ".h5")) || (len > 5 && !strcmp(path + len - 5, ".hdf5"));
+    int h5 = io_is_h5_path(path);
     int n = h5 ? read_packing_h5(cfg, path, pp) : read_packing_text(cfg, path, pp);
     if (n < 4) cfg_fail(cfg, "porenet", "packing", "%s: %d spheres (at least 4 needed)", path, n);
     pp->n = n;

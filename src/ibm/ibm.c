@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "ibm_internal.h"
+#include "io.h"
 #include "util.h"
 
 #define IBM_KEYED_SPHERES 9
@@ -364,14 +365,8 @@ static int h5_read(hid_t f, const char *name, hid_t type, void *buf)
 /* Spheres of an HDF5 packing (the DEM's packing/checkpoint layout). */
 static void spheres_from_h5(cfg_t *cfg, const char *path, double rho_default, ibm_sphere_t **s, int *n)
 {
-    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-    if (f < 0) cfg_fail(cfg, "ibm", "spheres_file", "cannot open %s as HDF5", path);
-    if (H5Lexists(f, "radius", H5P_DEFAULT) <= 0 || H5Lexists(f, "position", H5P_DEFAULT) <= 0)
-        cfg_fail(cfg, "ibm", "spheres_file", "%s: needs the datasets position [n][3] and radius [n]", path);
-    hid_t ds = H5Dopen2(f, "radius", H5P_DEFAULT), sp = H5Dget_space(ds);
-    hssize_t np = H5Sget_simple_extent_npoints(sp);
-    H5Sclose(sp);
-    H5Dclose(ds);
+    long np;
+    hid_t f = io_h5_open_packing(cfg, "ibm", "spheres_file", path, &np);
     size_t m = (size_t)np + 1;
     double *x = xcalloc(3 * m, sizeof(double)), *v = xcalloc(3 * m, sizeof(double)), *w = xcalloc(3 * m, sizeof(double));
     double *r = xcalloc(m, sizeof(double)), *rho = xcalloc(m, sizeof(double));
@@ -517,9 +512,8 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
     if (cfg_has(cfg, "ibm", "spheres_file")) {
         const char *path = cfg_string(cfg, "ibm", "spheres_file");
         double rho = cfg_has(cfg, "ibm", "density") ? cfg_double(cfg, "ibm", "density") : -1.0;
-        size_t len = strlen(path);
-        int n0 = n;
-        if ((len > 3 && !strcmp(path + len - 3, ".h5")) || (len > 5 && !strcmp(path + len - 5, ".hdf5")))
+            int n0 = n;
+        if (io_is_h5_path(path))
             spheres_from_h5(cfg, path, rho, &s, &n);
         else
             spheres_from_csv(cfg, path, rho, &s, &n);

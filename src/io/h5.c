@@ -248,3 +248,22 @@ static int attr_read(hid_t loc, const char *name, hid_t t, void *v)
 
 int io_h5_get_attr_double(hid_t loc, const char *name, double *v) { return attr_read(loc, name, H5T_NATIVE_DOUBLE, v); }
 int io_h5_get_attr_long(hid_t loc, const char *name, long *v) { return attr_read(loc, name, H5T_NATIVE_LONG, v); }
+
+int io_is_h5_path(const char *path)
+{
+    const size_t len = strlen(path);
+    return (len > 3 && !strcmp(path + len - 3, ".h5")) || (len > 5 && !strcmp(path + len - 5, ".hdf5"));
+}
+
+hid_t io_h5_open_packing(cfg_t *cfg, const char *section, const char *key, const char *path, long *n)
+{
+    hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0) cfg_fail(cfg, section, key, "cannot open %s as HDF5", path);
+    if (H5Lexists(f, "radius", H5P_DEFAULT) <= 0 || H5Lexists(f, "position", H5P_DEFAULT) <= 0)
+        cfg_fail(cfg, section, key, "%s: needs the datasets position [n][3] and radius [n]", path);
+    hid_t ds = H5Dopen2(f, "radius", H5P_DEFAULT), sp = H5Dget_space(ds);
+    *n = (long)H5Sget_simple_extent_npoints(sp);
+    H5Sclose(sp);
+    H5Dclose(ds);
+    return f;
+}
