@@ -438,20 +438,23 @@ static void test_consolidation(void **state)
     }
     if (mpi_rank() == 0)
         printf("# largest deviation from Terzaghi: %.4f (p_mid, p_base, U_corr); raw U: %.4f\n", dev, dev_raw);
-    double worst = 0;
     if (getenv("PN_REFERENCE")) {
+        double worst = 0;
         const wet_t e = run_wet(cfg, s0, &o, hnet, sigma0, dsig, H, L, dH, cv, 0.0, series, "every_step");
         if (mpi_rank() == 0)
             printf("# re-triangulating every step: %ld triangulations, %.3g ms CPU per step\n", e.retri, 1e3 * e.t_step);
         for (int k = 0; k < ntv && k < e.ntv; k++) {
             if (mpi_rank() == 0)
-                    printf("#   T_v = %.1f: p_mid/dsigma = %.4f (default %.4f), p_base/dsigma = %.4f (default %.4f), U = %.4f "
+                printf("#   T_v = %.1f: p_mid/dsigma = %.4f (default %.4f), p_base/dsigma = %.4f (default %.4f), U = %.4f "
                        "(default %.4f)\n",
                        TV[k], e.pmid[k], w.pmid[k], e.pbase[k], w.pbase[k], e.U[k], w.U[k]);
             worst = fmax(worst, fmax(fabs(e.pmid[k] - w.pmid[k]), fabs(e.U[k] - w.U[k])));
             worst = fmax(worst, fabs(e.pbase[k] - w.pbase[k]));
         }
         if (mpi_rank() == 0) printf("# largest difference (of Δσ, of ΔH): %.4f\n", worst);
+        /* §5.4: the default criterion agrees with every-step re-triangulation within 2 %
+         * (measured only in the reference run: PN_REFERENCE=1, scripts/validate.sh) */
+        assert_true(worst < 0.02);
     }
     if (series) fclose(series);
     /* the incompressible fluid takes the load step at once (undrained
@@ -470,8 +473,6 @@ static void test_consolidation(void **state)
     if (ntv >= 2) assert_true(w.ds > 0 && w.ds < 0.3);
     /* the raw U (the immediate compression included) of the coarse column: a regression bound */
     if (!getenv("PN_TOL")) assert_true(dev_raw < COARSE_RAW_TOL);
-    /* §5.4: the default criterion agrees with every-step re-triangulation within 2 % */
-    assert_true(worst < 0.02);
     if (mpi_rank() == 0) {
         char pk[600];
         snprintf(pk, sizeof pk, "%s/%s", dir, cfg_string(cfg, "packing", "output"));
