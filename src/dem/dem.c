@@ -586,7 +586,6 @@ void dem_wall_position(const dem_t *d, int w, double p[3])
     for (int a = 0; a < 3; a++) p[a] = d->wall[w].p[a];
 }
 void dem_set_damping(dem_t *d, double alpha) { d->damping = alpha; }
-double dem_damping(const dem_t *d) { return d->damping; }
 void dem_wall_set_point(dem_t *d, int w, const double p[3])
 {
     for (int a = 0; a < 3; a++) d->wall[w].p[a] = p[a];
