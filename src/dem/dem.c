@@ -381,9 +381,8 @@ void dem_sync_velocities(dem_t *d)
                 ta += d->text[3 * i + c];
             }
             if (d->damping > 0) {
-                /* the same damped resultant as kick_drift */
-                const double m = 1.0 / d->invm[i];
-                d->v[3 * i + c] += im * local_damping(fa + m * d->gravity[c], d->v[3 * i + c], d->damping);
+                /* the same damped resultant as kick_drift, bit for bit (m g as g / invm there) */
+                d->v[3 * i + c] += im * local_damping(fa + d->gravity[c] / d->invm[i], d->v[3 * i + c], d->damping);
                 d->w[3 * i + c] += ii * local_damping(ta, d->w[3 * i + c], d->damping);
                 continue;
             }
