@@ -29,6 +29,7 @@
  *    split among ranks: tests/test_dem_lists.c, with momentum.)
  */
 #include <stdlib.h>
+#include <string.h>
 
 #include "../src/dem/dem_private.h"
 #include "dem.h"
@@ -127,17 +128,18 @@ static void gas_run(int nc, const char *kink, long contacts, double *drift, long
     double e0 = -1;
     long c0 = 0;
     *multi = 0;
+    int *deg = malloc((size_t)d->n * sizeof(int)); /* contacts of each particle */
     for (;;) {
         assert_int_equal(dem_step(d), DEM_OK);
         dem_diag_light(d, &g);
         /* a particle in two contacts at once */
         if (d->n_contacts > 1) {
-            int *deg = calloc((size_t)d->n, sizeof(int)), more = 0;
+            int more = 0;
+            memset(deg, 0, (size_t)d->n * sizeof(int));
             for (int i = 0; i < d->nb_n_rows; i++)
                 for (int k = d->nb_start[i]; k < d->nb_start[i + 1]; k++)
                     if (d->nb_on[k]) more |= ++deg[i] > 1 || ++deg[d->nb_j[k]] > 1;
             *multi += more;
-            free(deg);
         }
         if (g.n_contacts) continue;
         int force = 0;
@@ -153,6 +155,7 @@ static void gas_run(int nc, const char *kink, long contacts, double *drift, long
             break;
         }
     }
+    free(deg);
     dem_free(d);
 }
 
