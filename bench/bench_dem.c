@@ -64,11 +64,6 @@ int main(int argc, char **argv)
     const double *x = dem_positions(d);
     double zmax = -1e300, L[3] = {0, 0, 0}, lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
     for (int i = 0; i < n; i++) zmax = fmax(zmax, x[3 * i + 2]);
-    /* the box: the walls on the faces */
-    for (int w = 0; w < dem_wall_count(d); w++) {
-        const char *nm = dem_wall_name(d, w);
-        (void)nm;
-    }
     {
         /* box size from the data file header, as LIGGGHTS' lx, ly */
         FILE *fp = fopen(data, "r");

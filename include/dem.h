@@ -88,7 +88,6 @@ void dem_set_gravity(dem_t *d, const double g[3]);
 void dem_get_gravity(const dem_t *d, double g[3]);
 /* Local non-viscous damping coefficient α (dem.damping). */
 void dem_set_damping(dem_t *d, double alpha);
-double dem_damping(const dem_t *d);
 /* The dry restitution coefficient e_dry (ε_max) of the contact law (0 if given by stiffness). */
 double dem_dry_restitution(const dem_t *d);
 

@@ -381,9 +381,8 @@ void dem_sync_velocities(dem_t *d)
                 ta += d->text[3 * i + c];
             }
             if (d->damping > 0) {
-                /* the same damped resultant as kick_drift */
-                const double m = 1.0 / d->invm[i];
-                d->v[3 * i + c] += im * local_damping(fa + m * d->gravity[c], d->v[3 * i + c], d->damping);
+                /* the same damped resultant as kick_drift, bit for bit (m g as g / invm there) */
+                d->v[3 * i + c] += im * local_damping(fa + d->gravity[c] / d->invm[i], d->v[3 * i + c], d->damping);
                 d->w[3 * i + c] += ii * local_damping(ta, d->w[3 * i + c], d->damping);
                 continue;
             }
@@ -586,7 +585,6 @@ void dem_wall_position(const dem_t *d, int w, double p[3])
     for (int a = 0; a < 3; a++) p[a] = d->wall[w].p[a];
 }
 void dem_set_damping(dem_t *d, double alpha) { d->damping = alpha; }
-double dem_damping(const dem_t *d) { return d->damping; }
 void dem_wall_set_point(dem_t *d, int w, const double p[3])
 {
     for (int a = 0; a < 3; a++) d->wall[w].p[a] = p[a];
