@@ -27,6 +27,19 @@ static inline __attribute__((always_inline)) void div_line(const double *restric
     }
 }
 
+/* div = scale · D u over the cells (i, j, k), j0 ≤ j < j1, k0 ≤ k < k1 (3-D),
+ * of the velocity arrays uu (which need not be f->u). */
+static void div_block(const fluid_t *f, const double *const uu[3], double scale, double *div, int i, int j0, int j1,
+                      int k0, int k1)
+{
+    const grid_t *g = f->g;
+    const fluid_priv_t *q = fluid_priv(f);
+    double a = q->af[i] / (q->ac[i] * g->dxf[i]), b = q->af[i - 1] / (q->ac[i] * g->dxf[i]);
+    for (int j = j0; j < j1; j++)
+        div_line(uu[0], uu[1], uu[2], div, G_IDX(g, i, j, k0), k1 - k0, g->sx, g->sy, a, b, 1.0 / g->dy,
+                 1.0 / g->dz, scale, 1);
+}
+
 void fluid_divergence_scaled(const fluid_t *f, double scale, double *div)
 {
     const grid_t *g = f->g;
@@ -40,6 +53,54 @@ void fluid_divergence_scaled(const fluid_t *f, double scale, double *div)
             if (w) div_line(u, v, w, div, c0, len, g->sx, g->sy, a, b, rdy, rdz, scale, 1);
             else div_line(u, v, w, div, c0, len, g->sx, g->sy, a, b, rdy, rdz, scale, 0);
         }
+    }
+}
+
+/* The cells whose divergence stencil reads only unknowns of this rank (no
+ * ghost, no halo, no boundary value): 3-D only, i in [1, ihi), j in [1, jhi),
+ * k in [1, khi), where the high bound excludes the last cell when the face
+ * beyond it is a wall (its normal velocity is a boundary value, set by
+ * fluid_apply_bc) and, for x, when the last local plane borders a wall.
+ * The cells next to a wall are also where the quadratic-ghost wall terms
+ * change u* after the sweep, so they are never in the interior. */
+fluid_interior_t fluid_interior(const grid_t *g)
+{
+    fluid_interior_t b;
+    b.ilo = 1;
+    b.ihi = !g->periodic[0] && g->right == MPI_PROC_NULL ? g->nxl - 1 : g->nxl;
+    b.jlo = 1;
+    b.jhi = g->periodic[1] ? g->n[1] : g->n[1] - 1;
+    b.klo = 1;
+    b.khi = g->periodic[2] ? g->n[2] : g->n[2] - 1;
+    return b;
+}
+
+/* Fused divergence (docs/theory.md §4.6): a sweep that writes u plane by plane
+ * calls this once plane i of every component is final, while the plane is
+ * still in cache; fluid_divergence_rest completes the field once the ghosts
+ * are valid.  Together they give exactly fluid_divergence_scaled (the same
+ * expression per cell). */
+void fluid_divergence_interior_plane(const fluid_t *f, const double *const uu[3], double scale, double *div, int i)
+{
+    fluid_interior_t b = fluid_interior(f->g);
+    if (i >= b.ilo && i < b.ihi) div_block(f, uu, scale, div, i, b.jlo, b.jhi, b.klo, b.khi);
+}
+
+void fluid_divergence_rest(const fluid_t *f, double scale, double *div)
+{
+    const grid_t *g = f->g;
+    const double *uu[3] = {f->u[0], f->u[1], f->u[2]};
+    fluid_interior_t b = fluid_interior(g);
+    int ny = g->n[1], nz = g->n[2];
+    for (int i = 0; i < g->nxl; i++) {
+        if (i < b.ilo || i >= b.ihi) {
+            div_block(f, uu, scale, div, i, 0, ny, 0, nz);
+            continue;
+        }
+        div_block(f, uu, scale, div, i, 0, b.jlo, 0, nz);
+        div_block(f, uu, scale, div, i, b.jhi, ny, 0, nz);
+        div_block(f, uu, scale, div, i, b.jlo, b.jhi, 0, b.klo);
+        div_block(f, uu, scale, div, i, b.jlo, b.jhi, b.khi, nz);
     }
 }
 
@@ -86,6 +147,43 @@ static void divergence_cfl_rate(const fluid_t *f, double *m)
     }
 }
 
+/* the same over the cells (i, j0..j1−1, k0..k1−1) of a 3-D grid */
+static void div_cfl_block(const fluid_t *f, double *m, int i, int j0, int j1, int k0, int k1)
+{
+    const grid_t *g = f->g;
+    const fluid_priv_t *q = fluid_priv(f);
+    double a = q->af[i] / (q->ac[i] * g->dxf[i]), b = q->af[i - 1] / (q->ac[i] * g->dxf[i]), rdx = 1.0 / g->dxf[i];
+    for (int j = j0; j < j1; j++)
+        div_cfl_line(f->u[0], f->u[1], f->u[2], G_IDX(g, i, j, k0), k1 - k0, g->sx, g->sy, a, b, rdx, 1.0 / g->dy,
+                     1.0 / g->dz, m, 1);
+}
+
+/* The diagnostic pass split as the fused divergence (fluid_interior): the
+ * interior of plane i from the sweep that makes it final, the rest after the
+ * ghosts are filled.  A maximum does not depend on the order. */
+void fluid_div_cfl_interior_plane(const fluid_t *f, int i, double *m)
+{
+    fluid_interior_t b = fluid_interior(f->g);
+    if (i >= b.ilo && i < b.ihi) div_cfl_block(f, m, i, b.jlo, b.jhi, b.klo, b.khi);
+}
+
+void fluid_div_cfl_rest(const fluid_t *f, double *m)
+{
+    const grid_t *g = f->g;
+    fluid_interior_t b = fluid_interior(g);
+    int ny = g->n[1], nz = g->n[2];
+    for (int i = 0; i < g->nxl; i++) {
+        if (i < b.ilo || i >= b.ihi) {
+            div_cfl_block(f, m, i, 0, ny, 0, nz);
+            continue;
+        }
+        div_cfl_block(f, m, i, 0, b.jlo, 0, nz);
+        div_cfl_block(f, m, i, b.jhi, ny, 0, nz);
+        div_cfl_block(f, m, i, b.jlo, b.jhi, 0, b.klo);
+        div_cfl_block(f, m, i, b.jlo, b.jhi, b.khi, nz);
+    }
+}
+
 double fluid_max_divergence(const fluid_t *f)
 {
     double loc[2] = {0.0, 0.0};
@@ -127,11 +225,15 @@ double fluid_kinetic_energy(const fluid_t *f)
 /* One sweep over the cells for the divergence and the convective rate (and,
  * unless the last projection gave them, one per component for the energy and
  * max |u|), two reductions. */
-void fluid_update_diagnostics(fluid_t *f, const double *stats)
+void fluid_update_diagnostics(fluid_t *f, const double *stats, const double *div_cfl)
 {
     const grid_t *g = f->g;
     double loc[3] = {0, 0, 0}, glob[3]; /* max |D u|, max Σ|u_d|/Δ_d, max |u| */
-    divergence_cfl_rate(f, loc);
+    if (div_cfl) {
+        loc[0] = div_cfl[0];
+        loc[1] = div_cfl[1];
+    } else
+        divergence_cfl_rate(f, loc);
     double e = 0.0;
     if (stats) {
         e = stats[0];

@@ -73,6 +73,10 @@ void fluid_rhs(const fluid_t *f, double ca, double cv, double *const out[3]);
  * H_old is not read when dz = 0, H not stored when H is NULL */
 void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
                        double *const H[3], double *const US[3]);
+/* the same, also div = div_scale · D u* on the interior cells (3-D,
+ * fluid_interior; the caller completes it with fluid_divergence_rest) */
+void fluid_rhs_predict_div(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
+                           double *const H[3], double *const US[3], double div_scale, double *div);
 /* viscous.c */
 void fluid_laplacian_add(const fluid_t *f, int c, const double *u, double scale, double *out);
 void fluid_wall_terms_add(const fluid_t *f, int c, double scale, double *out);
@@ -86,7 +90,20 @@ double fluid_convective_rate(const fluid_t *f);
  * Σ V u² and max |u| of this rank if already known, else NULL);
  * div = scale · D u at the cells */
 void fluid_divergence_scaled(const fluid_t *f, double scale, double *div);
-void fluid_update_diagnostics(fluid_t *f, const double *stats);
+/* ...(div_cfl: max |D u| and the max convective rate of this rank if already
+ * known, else NULL) */
+void fluid_update_diagnostics(fluid_t *f, const double *stats, const double *div_cfl);
+/* Fused divergence and diagnostics (3-D): the cells whose stencil reads only
+ * unknowns of this rank, computed by a sweep as soon as a plane is final, and
+ * the rest computed after the ghosts are filled; see diagnostics.c. */
+typedef struct {
+    int ilo, ihi, jlo, jhi, klo, khi;
+} fluid_interior_t;
+fluid_interior_t fluid_interior(const grid_t *g);
+void fluid_divergence_interior_plane(const fluid_t *f, const double *const uu[3], double scale, double *div, int i);
+void fluid_divergence_rest(const fluid_t *f, double scale, double *div);
+void fluid_div_cfl_interior_plane(const fluid_t *f, int i, double *m);
+void fluid_div_cfl_rest(const fluid_t *f, double *m);
 /* step.c */
 void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats);
 

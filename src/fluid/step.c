@@ -38,7 +38,8 @@ static inline double grad_rdx(const grid_t *g, int c, int i)
  * diagnostics.  With `fuse_p` the pressure update p += φ (explicit viscous
  * terms) is done on the lines of u, whose unknowns are the pressure cells
  * except the plane beyond an x wall (left to the caller). */
-static void correct_velocity(fluid_t *f, const double *restrict ph, double dt_stage, int fuse_p, double *stats)
+static void correct_velocity(fluid_t *f, const double *restrict ph, double dt_stage, int fuse_p, double *stats,
+                             double *div_cfl)
 {
     const grid_t *g = f->g;
     int nc = fluid_ncomp(g), is3d = g->dim == 3;
@@ -76,6 +77,9 @@ static void correct_velocity(fluid_t *f, const double *restrict ph, double dt_st
             }
         if (stats)
             for (int c = 0; c < nc; c++) e[c] += fluid_cell_volume(f, c, i) * ei[c];
+        /* plane i of u^k is final: its part of the diagnostics' max |D u| and
+         * convective rate (the rest once the ghosts are filled) */
+        if (div_cfl) fluid_div_cfl_interior_plane(f, i, div_cfl);
     }
     if (stats) {
         stats[0] += e[0] + e[1] + e[2];
@@ -83,13 +87,18 @@ static void correct_velocity(fluid_t *f, const double *restrict ph, double dt_st
     }
 }
 
-void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats)
+/* The projection of a stage.  div_ready: q->work already holds D(u*)/(αΔt)
+ * (the fused sweep of fluid_step).  div_cfl (3-D, or NULL): receives this
+ * rank's max |D u^k| and convective rate, computed in the correction sweep
+ * and completed after the ghost fill. */
+static void project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats, int div_ready,
+                          double *div_cfl)
 {
     const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
     /* the right-hand side D(u*)/(αΔt), then φ: solved in place */
     double *phi = q->work;
-    fluid_divergence_scaled(f, 1.0 / dt_stage, phi);
+    if (!div_ready) fluid_divergence_scaled(f, 1.0 / dt_stage, phi);
     if (poisson_solve(q->pp, 0.0, phi, phi) != 0)
         warn("step %ld: the pressure solve did not converge (residual %.3e)\n", f->step, q->pp->last_residual);
     f->diag.res_poisson = q->pp->last_residual;
@@ -97,7 +106,7 @@ void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, doubl
     fluid_fill_pressure_ghosts(f, phi);
     /* u −= α Δt G φ [and p += φ with explicit viscous terms], one sweep */
     int fuse_p = update_pressure && !f->prm.implicit_viscous;
-    correct_velocity(f, phi, dt_stage, fuse_p, stats);
+    correct_velocity(f, phi, dt_stage, fuse_p, stats, div_cfl);
     if (update_pressure) {
         if (f->prm.implicit_viscous) {
             /* p += φ − (α Δt ν/2) L φ: the pressure consistent with the
@@ -131,6 +140,12 @@ void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, doubl
         fluid_fill_pressure_ghosts(f, f->p);
     }
     fluid_apply_bc(f);
+    if (div_cfl) fluid_div_cfl_rest(f, div_cfl);
+}
+
+void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats)
+{
+    project_stage(f, dt_stage, update_pressure, stats, 0, NULL);
 }
 
 void fluid_stage_project(fluid_t *f, double dt_stage)
@@ -183,7 +198,11 @@ void fluid_step(fluid_t *f, double dt)
     const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
     int nc = fluid_ncomp(g);
-    double stats[2] = {0.0, 0.0};
+    double stats[2] = {0.0, 0.0}, div_cfl[2] = {0.0, 0.0};
+    /* Fused divergence (theory §4.6): D u* computed in the predictor sweep
+     * unless something changes u* between the sweep and the projection (the
+     * immersed-boundary hook, the Crank–Nicolson solves), 3-D only. */
+    int is3d = g->dim == 3, impl = f->prm.implicit_viscous, fuse_div = is3d && !impl && !f->stage_hook;
     for (int s = 0; s < 3; s++) {
         double adt = (fluid_rk_gamma[s] + fluid_rk_zeta[s]) * dt;
         /* H^k = −∇·(u⊗u) [+ νLu] from u^{k−1} (its ghosts are valid: every
@@ -193,9 +212,9 @@ void fluid_step(fluid_t *f, double dt)
          * u ← u*, h ← H^k, spare ← u^{k−1} (free).  The last stage's H is
          * not needed (ζ_1 = 0: the first stage of the next step does not
          * read H_old), so it is not stored. */
-        int impl = f->prm.implicit_viscous;
-        fluid_rhs_predict(f, -1.0, impl ? 0.0 : f->prm.nu, dt * fluid_rk_gamma[s], dt * fluid_rk_zeta[s], adt,
-                          impl ? 0.5 * adt * f->prm.nu : 0.0, s < 2 ? q->spare : NULL, q->h);
+        fluid_rhs_predict_div(f, -1.0, impl ? 0.0 : f->prm.nu, dt * fluid_rk_gamma[s], dt * fluid_rk_zeta[s], adt,
+                              impl ? 0.5 * adt * f->prm.nu : 0.0, s < 2 ? q->spare : NULL, q->h, 1.0 / adt,
+                              fuse_div ? q->work : NULL);
         for (int c = 0; c < nc; c++) {
             double *old = f->u[c];
             f->u[c] = q->h[c];
@@ -205,15 +224,16 @@ void fluid_step(fluid_t *f, double dt)
         if (impl)
             for (int c = 0; c < nc; c++) helmholtz_component(f, c, adt, q->spare[c] /* u^{k−1} */);
         fluid_apply_bc(f);
+        if (fuse_div) fluid_divergence_rest(f, 1.0 / adt, q->work);
         if (f->stage_hook) {
             f->stage_hook(f, s, adt, f->hook_ctx);
             fluid_apply_bc(f);
         }
-        fluid_project_stage(f, adt, 1, s == 2 ? stats : NULL);
+        project_stage(f, adt, 1, s == 2 ? stats : NULL, fuse_div, s == 2 && is3d ? div_cfl : NULL);
         if (f->stage_end_hook) f->stage_end_hook(f, s, adt, f->hook_ctx);
     }
     f->time += dt;
     f->step++;
     f->diag.dt = dt;
-    fluid_update_diagnostics(f, stats);
+    fluid_update_diagnostics(f, stats, is3d ? div_cfl : NULL);
 }
