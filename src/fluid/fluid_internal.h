@@ -87,11 +87,10 @@ void fluid_fill_pressure_ghosts(const fluid_t *f, double *p);
 /* timestep.c: max over cells of Σ_d |u_d|/Δ_d (|u_d| the larger of the two faces) */
 double fluid_convective_rate(const fluid_t *f);
 /* diagnostics.c: ke, div_max, cfl of f->diag from the current field (stats:
- * Σ V u² and max |u| of this rank if already known, else NULL);
- * div = scale · D u at the cells */
+ * Σ V u² and max |u| of this rank if already known, else NULL; div_cfl: max
+ * |D u| and the max convective rate of this rank if already known, else
+ * NULL); div = scale · D u at the cells */
 void fluid_divergence_scaled(const fluid_t *f, double scale, double *div);
-/* ...(div_cfl: max |D u| and the max convective rate of this rank if already
- * known, else NULL) */
 void fluid_update_diagnostics(fluid_t *f, const double *stats, const double *div_cfl);
 /* Fused divergence and diagnostics (3-D): the cells whose stencil reads only
  * unknowns of this rank, computed by a sweep as soon as a plane is final, and
