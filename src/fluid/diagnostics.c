@@ -75,7 +75,7 @@ fluid_interior_t fluid_interior(const grid_t *g)
     return b;
 }
 
-/* Fused divergence (docs/theory.md §4.6): a sweep that writes u plane by plane
+/* Fused divergence (docs/theory.md §1, step 1.1): a sweep that writes u plane by plane
  * calls this once plane i of every component is final, while the plane is
  * still in cache; fluid_divergence_rest completes the field once the ghosts
  * are valid.  Together they give exactly fluid_divergence_scaled (the same

@@ -199,7 +199,7 @@ void fluid_step(fluid_t *f, double dt)
     fluid_priv_t *q = fluid_priv(f);
     int nc = fluid_ncomp(g);
     double stats[2] = {0.0, 0.0}, div_cfl[2] = {0.0, 0.0};
-    /* Fused divergence (theory §4.6): D u* computed in the predictor sweep
+    /* Fused divergence (theory §1, step 1.1): D u* computed in the predictor sweep
      * unless something changes u* between the sweep and the projection (the
      * immersed-boundary hook, the Crank–Nicolson solves), 3-D only. */
     int is3d = g->dim == 3, impl = f->prm.implicit_viscous, fuse_div = is3d && !impl && !f->stage_hook;
