@@ -58,17 +58,40 @@ if want dem; then
     [ -f "$BUILD/bench_dem/dem_bench.md" ] && sed 's/^/[dem] /' "$BUILD/bench_dem/dem_bench.md" >>"$RES"
 fi
 
-# Record the raw results in docs/performance.md.
+# Record the raw results in docs/performance.md: the sections run now replace
+# their own lines; the lines of sections not run (ONLY=...) are kept, with the
+# date and commit of the run that wrote them.
 /usr/bin/python3 - "$RES" <<'PY'
 import re, subprocess, sys, datetime
-res = open(sys.argv[1]).read()
 rev = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-load = open("/proc/loadavg").read().split()[:3]
-block = ("<!-- make bench: begin -->\n"
-         f"Last `make bench` run: {datetime.datetime.utcnow():%Y-%m-%d %H:%M} UTC, commit {rev}, "
-         f"load average {' '.join(load)} (2 cores).\n\n```\n{res}```\n<!-- make bench: end -->")
+load = " ".join(open("/proc/loadavg").read().split()[:3])
+stamp = f"{datetime.datetime.utcnow():%Y-%m-%d %H:%M} UTC, commit {rev}, load {load}"
+def section(line):
+    m = re.match(r"\[([^\]]+)\]", line)
+    return m.group(1) if m else None
+new = [l for l in open(sys.argv[1]).read().splitlines() if l.strip()]
+run_now = {section(l) for l in new}
 p = "docs/performance.md"
 doc = open(p).read()
+m = re.search(r"<!-- make bench: begin -->.*?```\n(.*?)```", doc, flags=re.S)
+old = m.group(1).splitlines() if m else []
+# an old line "[name] text" or "[name] (stamp) text": keep it with its stamp if name was not run now
+kept, cur_stamp = [], None
+m2 = re.search(r"Last `make bench` run: ([^(]*?), load average ([0-9. ]+)", doc)
+default_stamp = f"{m2.group(1)}, load {m2.group(2).strip()}" if m2 else "earlier run"
+for l in old:
+    name = section(l)
+    if name is None or name in run_now:
+        continue
+    if re.match(r"\[[^\]]+\] \{", l):
+        kept.append(l)
+    else:
+        kept.append(l.replace(f"[{name}] ", f"[{name}] {{{default_stamp}}} ", 1))
+body = "\n".join([l.replace(f"[{section(l)}] ", f"[{section(l)}] {{{stamp}}} ", 1) for l in new] + kept)
+block = ("<!-- make bench: begin -->\n"
+         f"Last `make bench` run: {stamp} (2 cores); each line carries the run that wrote it "
+         "(sections not run by the last call keep their earlier lines).\n\n"
+         f"```\n{body}\n```\n<!-- make bench: end -->")
 if "<!-- make bench: begin -->" in doc:
     doc = re.sub(r"<!-- make bench: begin -->.*?<!-- make bench: end -->", lambda m: block, doc, flags=re.S)
 else:
