@@ -571,6 +571,7 @@ static void test_consolidation(void **state)
         rmdir(dir);
     }
     free(o.top);
+    free(o.marker);
     dem_free(d);
     cfg_free(cfg);
 }
