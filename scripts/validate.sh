@@ -86,7 +86,9 @@ rm -rf "$d"
 # --- porenet: Terzaghi consolidation in an oedometer (cases/consolidation/oedometer.ini,
 # 600 spheres, 22 grains high; catalano_pfv.md §5.4): p at mid-height and at the sealed base
 # and U_corr (the settlement with the initial compression removed by Taylor's sqrt(t) method,
-# ASTM D2435) against the series at T_v = 0.1, 0.2, 0.5, 1 within ±0.05 (PN_TOL), E_oed and
+# ASTM D2435) and U_marker (the settlement of the grains 1-2 d below the piston over their dry
+# settlement, against the series of the sub-layer below them; no correction)
+# against the series at T_v = 0.1, 0.2, 0.5, 1 within ±0.05 (PN_TOL), E_oed and
 # kappa measured on the same packing; the raw U is printed, not asserted (it is 0.069 above the
 # series at T_v = 0.1: docs/validation.md); figure consolidation.png.  About 63 000 coupled
 # steps (~3 min of CPU).  Then the coarse column (300 spheres) to T_v = 0.2 with the default
