@@ -9,7 +9,7 @@
 #     gap, logarithmic in it, is still to come);
 #  2. restart: a run through the bounce and the same run stopped before it and restarted give
 #     bit-identical particle and fluid states (h5diff --delta=0) and the same restitution results,
-#     with the default coupling and with [coupling] added_mass = consistent;
+#     with the default coupling (added_mass = consistent) and with added_mass = none;
 #  3. 1 vs 2 ranks: the same bounce to round-off (eps/eps_max within 1e-9);
 #  4. dry scene ([coupling] fluid = off) with lubrication: a sphere thrown at a wall without
 #     gravity leaves the lubrication range at the exact speed u_R = e u_C - (k/m) dL, u_C = u_0 - (k/m) dL,
@@ -40,7 +40,7 @@ PY
 report $? "sub-cycling: eps/eps_max and V_C do not change when M varies 10x"
 
 # 2. restart through the bounce (contact at step ~1060 at this resolution), with the default
-#    coupling and with [coupling] added_mass = consistent (its collision velocity change is state)
+#    coupling (added_mass = consistent: its collision velocity change is state) and with none
 restart_check() { # name, extra args
     local n=$1; shift
     local R="$C --set output.series_every=1 $*" rc
@@ -64,8 +64,8 @@ restart_check() { # name, extra args
 }
 restart_check ""
 report $? "restart through the bounce is bit-identical (fluid, particles, spheres, restitution)"
-restart_check _am --set coupling.added_mass=consistent
-report $? "restart through the bounce with added_mass = consistent is bit-identical"
+restart_check _none --set coupling.added_mass=none
+report $? "restart through the bounce with added_mass = none is bit-identical"
 
 # 3. ranks
 $MPIRUN -np 2 $BIN run $INI $C --set coupling.stop_after_rebound=true --out $T/np2 >$T/np2.log 2>&1

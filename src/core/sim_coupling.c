@@ -36,7 +36,7 @@ static const cfg_key_t coupling_keys[] = {
      "hold a particle's hydrodynamic force at its value before a contact for up to this many contact times "
      "of contact, the fluid's force meanwhile applied after it (the seed's fluid frozen during collisions; "
      "matters when the fluid step is shorter than t_c); 0: off"},
-    {"coupling", "added_mass", CFG_ENUM, "none", 1, 0, "none|consistent",
+    {"coupling", "added_mass", CFG_ENUM, "consistent", 1, 0, "none|consistent",
      "none: contact and lubrication forces act on m_p, the fluid's reaction to a collision comes through the next "
      "fluid step; consistent: they act on m_p + C_M rho V_p (Izard eqs. 3.24, 3.26) and the fluid's reaction "
      "C_M rho V_p dU/dt_f to the velocity change they made is removed from the next held force (docs/theory.md §9.1)"},
