@@ -45,11 +45,35 @@ typedef struct {
 } coupling_freeze_t;
 void coupling_freeze_init(coupling_freeze_t *fz, int n, double hold_time);
 void coupling_freeze_free(coupling_freeze_t *fz);
+/* The added-mass-consistent collision ([coupling] added_mass = consistent,
+ * docs/theory.md §9.1): inside the DEM sub-steps the contact and lubrication
+ * forces act on m* = m_p + C_M ρ V_p (Izard eqs. 3.24, 3.26) while the held
+ * hydrodynamic force, the buoyancy and the weight keep their acceleration
+ * (F/m_p); the velocity change the contact and lubrication forces produced
+ * in a step, ΔU_c, makes the fluid react in the next step by ≈ −C_M ρ V_p
+ * ΔU_c (its added mass, already moved by the DEM), so C_M ρ V_p ΔU_c/Δt_f is
+ * added back to the next held force: over the two steps the particle gets
+ * the same momentum as without the option, the fluid's reaction is not
+ * counted twice. */
+typedef struct {
+    int n;
+    double cm;      /* C_M */
+    double *dU;     /* 3n: ΔU_c of the last step (by sphere), added back to the next held force */
+    double *U0;     /* 3n: velocity at the start of the step */
+    double *slow;   /* 3n: velocity change the held force, buoyancy and weight give over the step */
+} coupling_added_mass_t;
+void coupling_added_mass_init(coupling_added_mass_t *am, int n, double cm);
+void coupling_added_mass_free(coupling_added_mass_t *am);
+/* The particles' inertia m_p + C_M ρ V_p in the DEM (idempotent: at setup and after a restart). */
+void coupling_added_mass_apply(const coupling_added_mass_t *am, dem_t *d, double rho_fluid);
+/* After the DEM advanced a fluid step: ΔU_c of every particle. */
+void coupling_added_mass_after_step(coupling_added_mass_t *am, const dem_t *d);
 /* Step 1 → 2: hand the hydrodynamic force and torque of the last fluid step
  * (of length dt), with the buoyancy −ρ V_p g, to the DEM as its external
- * force and torque, through the freeze fz (NULL: none). */
+ * force and torque, through the freeze fz (NULL: none) and with the
+ * added-mass correction am (NULL: none). */
 void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3],
-                            coupling_freeze_t *fz, double dt);
+                            coupling_freeze_t *fz, coupling_added_mass_t *am, double dt);
 /* Step 2 → 3: positions and velocities of the particles to the spheres, and
  * the solid fraction rebuilt (collective). */
 void coupling_motion_to_ibm(const dem_t *d, ibm_t *ibm);

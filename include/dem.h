@@ -99,7 +99,16 @@ const double *dem_omegas(const dem_t *d);
 const double *dem_radii(const dem_t *d);
 const long *dem_ids(const dem_t *d);
 const unsigned char *dem_fixed(const dem_t *d);
-double dem_mass(const dem_t *d, int i); /* 0 for a fixed particle's inverse → returns +inf */
+double dem_mass(const dem_t *d, int i); /* inertial mass (with any added mass); +inf for a fixed particle */
+/* The particle's material density (its mass is density × volume without added mass). */
+double dem_density(const dem_t *d, int i);
+/* Added mass m_a of particle i (the resolved coupling's [coupling] added_mass, docs/theory.md §9.1):
+ * from now on the particle's translational inertia is ρ_p V_p + m_a for every force (contacts,
+ * lubrication, the external force and gravity; the caller scales the external force so that the
+ * forces it does not want on m_a keep their acceleration); the rotational inertia is unchanged.
+ * Sets the mass from the density, so calling it again with the same m_a changes nothing; call it
+ * before the first step (contact forces already computed keep the mass they were computed with). */
+void dem_set_added_mass(dem_t *d, int i, double added_mass);
 /* Writable per-particle inputs, added to the contact forces and gravity at
  * every step (zeroed at creation). */
 double *dem_ext_force(dem_t *d);

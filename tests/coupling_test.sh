@@ -8,7 +8,8 @@
 #     is not compared: it is taken up to u dt_s from the wall and the lubrication of that last
 #     gap, logarithmic in it, is still to come);
 #  2. restart: a run through the bounce and the same run stopped before it and restarted give
-#     bit-identical particle and fluid states (h5diff --delta=0) and the same restitution results;
+#     bit-identical particle and fluid states (h5diff --delta=0) and the same restitution results,
+#     with the default coupling (added_mass = consistent) and with added_mass = none;
 #  3. 1 vs 2 ranks: the same bounce to round-off (eps/eps_max within 1e-9);
 #  4. dry scene ([coupling] fluid = off) with lubrication: a sphere thrown at a wall without
 #     gravity leaves the lubrication range at the exact speed u_R = e u_C - (k/m) dL, u_C = u_0 - (k/m) dL,
@@ -38,25 +39,33 @@ sys.exit(0 if de < 1e-3 and dc < 1e-3 and b["dem_substeps"] > 9 * a["dem_substep
 PY
 report $? "sub-cycling: eps/eps_max and V_C do not change when M varies 10x"
 
-# 2. restart through the bounce (contact at step ~1060 at this resolution)
-R="$C --set output.series_every=1"
-$BIN run $INI $R --set time.max_steps=1075 --out $T/straight >$T/r.log 2>&1 &&
-$BIN run $INI $R --set time.max_steps=1040 --out $T/split >>$T/r.log 2>&1 &&
-$BIN run $INI $R --set time.max_steps=1075 --out $T/split --restart $T/split/checkpoint_00001040.h5 >>$T/r.log 2>&1
-rc=$?
-if [ $rc = 0 ]; then
-    a=$(ls $T/straight/checkpoint_*.h5 | tail -1); b=$(ls $T/split/checkpoint_*.h5 | tail -1)
-    for g in fluid dem ibm; do
-        for v in $(h5ls -r "$a/$g" | awk '$2 == "Dataset" {print $1}'); do
-            h5diff --delta=0 "$a" "$b" "/$g$v" "/$g$v" >/dev/null 2>&1 || { echo "# differs: /$g$v"; rc=1; }
+# 2. restart through the bounce (contact at step ~1060 at this resolution), with the default
+#    coupling (added_mass = consistent: its collision velocity change is state) and with none
+restart_check() { # name, extra args
+    local n=$1; shift
+    local R="$C --set output.series_every=1 $*" rc
+    $BIN run $INI $R --set time.max_steps=1075 --out $T/straight$n >$T/r$n.log 2>&1 &&
+    $BIN run $INI $R --set time.max_steps=1040 --out $T/split$n >>$T/r$n.log 2>&1 &&
+    $BIN run $INI $R --set time.max_steps=1075 --out $T/split$n --restart $T/split$n/checkpoint_00001040.h5 >>$T/r$n.log 2>&1
+    rc=$?
+    if [ $rc = 0 ]; then
+        a=$(ls $T/straight$n/checkpoint_*.h5 | tail -1); b=$(ls $T/split$n/checkpoint_*.h5 | tail -1)
+        for g in fluid dem ibm coupling; do
+            for v in $(h5ls -r "$a/$g" | awk '$2 == "Dataset" {print $1}'); do
+                h5diff --delta=0 "$a" "$b" "/$g$v" "/$g$v" >/dev/null 2>&1 || { echo "# differs: /$g$v"; rc=1; }
+            done
         done
-    done
-    for k in epsilon V_T V_R V_C t_contact; do
-        [ "$(val $T/straight/summary.json $k)" = "$(val $T/split/summary.json $k)" ] || { echo "# $k differs"; rc=1; }
-    done
-    echo "# straight: eps/eps_max $(val $T/straight/summary.json epsilon_over_max), restarted $(val $T/split/summary.json epsilon_over_max)"
-fi
-report $rc "restart through the bounce is bit-identical (fluid, particles, spheres, restitution)"
+        for k in epsilon V_T V_R V_C t_contact; do
+            [ "$(val $T/straight$n/summary.json $k)" = "$(val $T/split$n/summary.json $k)" ] || { echo "# $k differs"; rc=1; }
+        done
+        echo "# $n straight: eps/eps_max $(val $T/straight$n/summary.json epsilon_over_max), restarted $(val $T/split$n/summary.json epsilon_over_max)"
+    fi
+    return $rc
+}
+restart_check ""
+report $? "restart through the bounce is bit-identical (fluid, particles, spheres, restitution)"
+restart_check _none --set coupling.added_mass=none
+report $? "restart through the bounce with added_mass = none is bit-identical"
 
 # 3. ranks
 $MPIRUN -np 2 $BIN run $INI $C --set coupling.stop_after_rebound=true --out $T/np2 >$T/np2.log 2>&1

@@ -36,6 +36,12 @@ static const cfg_key_t coupling_keys[] = {
      "hold a particle's hydrodynamic force at its value before a contact for up to this many contact times "
      "of contact, the fluid's force meanwhile applied after it (the seed's fluid frozen during collisions; "
      "matters when the fluid step is shorter than t_c); 0: off"},
+    {"coupling", "added_mass", CFG_ENUM, "consistent", 1, 0, "none|consistent",
+     "none: contact and lubrication forces act on m_p, the fluid's reaction to a collision comes through the next "
+     "fluid step; consistent: they act on m_p + C_M rho V_p (Izard eqs. 3.24, 3.26) and the fluid's reaction "
+     "C_M rho V_p dU/dt_f to the velocity change they made is removed from the next held force (docs/theory.md §9.1)"},
+    {"coupling", "added_mass_coefficient", CFG_DOUBLE, "0.5", 0, 10, NULL,
+     "added_mass = consistent: C_M (1/2, a sphere in unbounded fluid, the seed's value for walls and pairs)"},
     {"coupling", "restitution_axis", CFG_VEC3, NULL, -1e300, 1e300, NULL,
      "wall: direction from the particle towards the wall (default: along gravity)"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
@@ -58,6 +64,7 @@ typedef struct {
     int align;           /* [coupling] align_contacts */
     double freeze;       /* [coupling] freeze_collisions (contact times) */
     coupling_freeze_t fz;
+    coupling_added_mass_t am; /* [coupling] added_mass = consistent (am.n > 0) */
     double wall_dem;     /* wall time in the DEM */
     long substeps;       /* DEM sub-steps done */
 } coupling_part_t;
@@ -78,7 +85,7 @@ static void tracked_particle(coupling_part_t *cp)
     for (int i = 0; i < dem_count(cp->d); i++)
         if (id[i] == 0) {
             const double r = dem_radii(cp->d)[i];
-            cp->rest.rho_p = dem_mass(cp->d, i) / (4.0 / 3.0 * M_PI * r * r * r);
+            cp->rest.rho_p = dem_density(cp->d, i);
             cp->rest.D = 2 * r;
         }
     cp->rest.e_dry = dem_dry_restitution(cp->d);
@@ -92,6 +99,7 @@ static void attach(coupling_part_t *cp)
     tracked_particle(cp);
     dem_get_gravity(cp->d, cp->gravity);
     if (cp->fz.n) cp->fz.hold_time = cp->freeze * dem_contact_time(cp->d);
+    if (cp->am.n) coupling_added_mass_apply(&cp->am, cp->d, cp->rho_f);
     if (cp->rest.mode != RESTITUTION_OFF) dem_set_step_observer(cp->d, observe, cp);
     if (cp->ibm) memcpy(cp->ibm->prm.gravity, cp->gravity, sizeof cp->gravity);
 }
@@ -129,8 +137,10 @@ static void part_advance(void *ctx, double dt)
     setup(cp);
     if (cp->ibm) {
         const double w0 = wtime();
-        coupling_forces_to_dem(cp->ibm, cp->d, cp->rho_f, cp->gravity, cp->fz.n ? &cp->fz : NULL, dt);
+        coupling_added_mass_t *am = cp->am.n ? &cp->am : NULL;
+        coupling_forces_to_dem(cp->ibm, cp->d, cp->rho_f, cp->gravity, cp->fz.n ? &cp->fz : NULL, am, dt);
         cp->status = dem_advance(cp->d, dem_time(cp->d) + dt);
+        if (am) coupling_added_mass_after_step(am, cp->d);
         cp->wall_dem += wtime() - w0;
         if (cp->status == DEM_OK) coupling_motion_to_ibm(cp->d, cp->ibm);
     }
@@ -176,6 +186,7 @@ static void part_checkpoint_write(void *ctx, hid_t grp)
         io_h5_write_array(grp, "freeze_impulse", 6L * cp->fz.n, cp->fz.J);
         io_h5_write_array(grp, "freeze_held", cp->fz.n, cp->fz.held);
     }
+    if (cp->am.n) io_h5_write_array(grp, "added_mass_dU", 3L * cp->am.n, cp->am.dU);
 }
 
 static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
@@ -195,6 +206,8 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
             io_h5_read_array(grp, "freeze_held", n, cp->fz.held) != n)
             die("%s: /coupling/freeze_* is missing or has the wrong size", path);
     }
+    if (cp->am.n && io_h5_read_array(grp, "added_mass_dU", 3L * cp->am.n, cp->am.dU) != 3L * cp->am.n)
+        die("%s: /coupling/added_mass_dU is missing or has the wrong size", path);
     cp->synced = 1; /* the spheres and particles come from the checkpoint */
     attach(cp);
 }
@@ -257,6 +270,7 @@ static void part_destroy(void *ctx)
 {
     coupling_part_t *cp = ctx;
     coupling_freeze_free(&cp->fz);
+    coupling_added_mass_free(&cp->am);
     free(cp);
 }
 
@@ -285,6 +299,8 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
     cp->align = cfg_bool(cfg, "coupling", "align_contacts");
     cp->freeze = cfg_double(cfg, "coupling", "freeze_collisions");
     if (ibm && cp->freeze > 0 && ibm->n > 0) coupling_freeze_init(&cp->fz, ibm->n, 0.0); /* hold time at setup */
+    if (ibm && ibm->n > 0 && cfg_enum(cfg, "coupling", "added_mass") == 1)
+        coupling_added_mass_init(&cp->am, ibm->n, cfg_double(cfg, "coupling", "added_mass_coefficient"));
     cp->stop_after = mode != RESTITUTION_OFF && cfg_bool(cfg, "coupling", "stop_after_rebound");
     sim_part_t part = {
         .name = "coupling",

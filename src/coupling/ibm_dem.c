@@ -19,7 +19,7 @@ ibm_sphere_t *coupling_spheres_of_particles(const dem_t *d, int *n)
         ibm_sphere_t *t = &s[id[i]];
         t->kind = IBM_EXTERNAL;
         t->radius = r[i];
-        t->density = dem_mass(d, i) / (4.0 / 3.0 * M_PI * r[i] * r[i] * r[i]);
+        t->density = dem_density(d, i);
         t->history = -1;
         for (int a = 0; a < 3; a++) {
             t->x[a] = t->xa[a] = x[3 * i + a];
@@ -48,8 +48,43 @@ void coupling_freeze_free(coupling_freeze_t *fz)
     memset(fz, 0, sizeof *fz);
 }
 
+void coupling_added_mass_init(coupling_added_mass_t *am, int n, double cm)
+{
+    am->n = n;
+    am->cm = cm;
+    am->dU = xcalloc(3 * (size_t)(n > 0 ? n : 1), sizeof(double));
+    am->U0 = xcalloc(3 * (size_t)(n > 0 ? n : 1), sizeof(double));
+    am->slow = xcalloc(3 * (size_t)(n > 0 ? n : 1), sizeof(double));
+}
+
+void coupling_added_mass_free(coupling_added_mass_t *am)
+{
+    free(am->dU);
+    free(am->U0);
+    free(am->slow);
+    memset(am, 0, sizeof *am);
+}
+
+void coupling_added_mass_apply(const coupling_added_mass_t *am, dem_t *d, double rho_fluid)
+{
+    const double *r = dem_radii(d);
+    for (int i = 0; i < dem_count(d); i++)
+        dem_set_added_mass(d, i, am->cm * rho_fluid * 4.0 / 3.0 * M_PI * r[i] * r[i] * r[i]);
+}
+
+void coupling_added_mass_after_step(coupling_added_mass_t *am, const dem_t *d)
+{
+    const long *id = dem_ids(d);
+    for (int i = 0; i < dem_count(d); i++) {
+        const long p = id[i];
+        double U[3];
+        dem_full_velocity(d, i, U);
+        for (int a = 0; a < 3; a++) am->dU[3 * p + a] = U[a] - am->U0[3 * p + a] - am->slow[3 * p + a];
+    }
+}
+
 void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3],
-                            coupling_freeze_t *fz, double dt)
+                            coupling_freeze_t *fz, coupling_added_mass_t *am, double dt)
 {
     double *fe = dem_ext_force(d), *te = dem_ext_torque(d);
     const double *r = dem_radii(d);
@@ -59,6 +94,10 @@ void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const 
         const ibm_sphere_t *s = &ibm->s[p];
         const double V = 4.0 / 3.0 * M_PI * r[i] * r[i] * r[i];
         double F[6] = {s->force[0], s->force[1], s->force[2], s->torque[0], s->torque[1], s->torque[2]};
+        /* the fluid's reaction to the collision velocity change of the last step, ≈ −C_M ρ V ΔU_c/Δt,
+         * was already taken by the DEM (contacts and lubrication on m*): added back */
+        if (am)
+            for (int a = 0; a < 3; a++) F[a] += am->cm * rho_fluid * V * am->dU[3 * p + a] / dt;
         if (fz) {
             const int contact = dem_in_contact(d, i);
             double *F0 = fz->F0 + 6 * p, *J = fz->J + 6 * p;
@@ -83,6 +122,18 @@ void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const 
              * needs the buoyancy −ρ V_p g besides the hydrodynamic force of the immersed boundary */
             fe[3 * i + a] = F[a] - rho_fluid * V * gravity[a];
             te[3 * i + a] = F[3 + a];
+        }
+        if (am) {
+            /* the DEM's inertia is m* = m_p + C_M ρ V: the held force scaled by m* over m_p keeps the acceleration
+             * (F_h − ρ V g)/m_p + g of the forces that are not the collision's */
+            const double mstar = dem_mass(d, i), mp = dem_density(d, i) * V;
+            double U[3];
+            dem_full_velocity(d, i, U);
+            for (int a = 0; a < 3; a++) {
+                fe[3 * i + a] *= mstar / mp;
+                am->U0[3 * p + a] = U[a];
+                am->slow[3 * p + a] = dt * (fe[3 * i + a] / mstar + gravity[a]);
+            }
         }
     }
 }

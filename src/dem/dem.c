@@ -563,6 +563,14 @@ const double *dem_radii(const dem_t *d) { return d->r; }
 const long *dem_ids(const dem_t *d) { return d->id; }
 const unsigned char *dem_fixed(const dem_t *d) { return d->fixed; }
 double dem_mass(const dem_t *d, int i) { return d->invm[i] > 0 ? 1.0 / d->invm[i] : INFINITY; }
+double dem_density(const dem_t *d, int i) { return d->rho[i]; }
+void dem_set_added_mass(dem_t *d, int i, double added_mass)
+{
+    const double invm = 1.0 / (d->rho[i] * dem_sphere_volume(d->r[i]) + added_mass);
+    if (d->fixed[i] || invm == d->invm[i]) return;
+    dem_sync_velocities(d); /* the pending half kick belongs to the old mass */
+    d->invm[i] = invm; /* forces already computed keep the old mass until the next step (a restart continues exactly) */
+}
 double *dem_ext_force(dem_t *d)
 {
     d->use_ext = 1;

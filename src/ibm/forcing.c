@@ -134,7 +134,7 @@ static void force_nodes(ibm_t *ibm, double dt)
     long st = q->rstride;
     int fast = kappa <= 0 && st == 1, first = q->imp_fresh;
     q->imp_fresh = 0;
-    if (first && !fast) memset(q->node_imp, 0, (size_t)q->nnodes * sizeof(double));
+    if (first && !fast && q->nnodes > 0) memset(q->node_imp, 0, (size_t)q->nnodes * sizeof(double)); /* none on this rank: NULL */
     for (long ir = 0; ir < q->n_nruns; ir++) {
         const ibm_node_run_t *nr = &q->nruns_f[ir];
         double *u = ibm->f->u[nr->c] + nr->m0, *J = q->node_imp + nr->n0;
