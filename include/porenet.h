@@ -199,8 +199,10 @@ typedef struct {
     double dt_factor;   /* ζ of the coupled time step (thesis 4.21) */
     double eps_acc;     /* accumulated pore strain since the last triangulation */
     long n_retri, n_steps;
-    /* wall times: last triangulation / network / factorisation, cumulated solve and force times */
-    double t_tri, t_net, t_factor, t_solve, t_force, t_vol;
+    /* CPU times of the process (cputime(): the machine may be shared): last triangulation / network /
+     * factorisation, cumulated rebuilds (all three), volume rates, solves (right-hand side and
+     * back-substitution) and forces */
+    double t_tri, t_net, t_factor, t_rebuild, t_solve, t_force, t_vol;
     double *snap_time;  /* times of the snapshots written (output.c) */
     long *snap_counts;  /* points, tetrahedra, throats, spheres of each snapshot */
     int nsnap;
