@@ -59,6 +59,8 @@ typedef struct {
     double *r;          /* radii */
     int *id;            /* index of the sphere in the input arrays */
     signed char *img;   /* 3*npts: per axis -1, 0, +1: periodic shift (× length) or mirror across lo / hi */
+    double *xm, *xo;    /* 3*npts: the image as an affine map of its sphere's centre, x_img = xm x + xo
+                           (xm = ±1; pn_tri_point, the pore volumes of every step) */
     /* Tetrahedra of the lower hull of the lifted points (all of them, images included). */
     int ntet;
     int *tet;           /* 4*ntet point indices */
@@ -108,6 +110,7 @@ typedef struct {
                          section(s) with the wall plane(s), pointing out of the box (0 inside) */
     double *bc_area;  /* area of the pore's section with its first wall face (PN_BC_FLUX shares) */
     int *ntets, *tets;/* tetrahedra of each pore: tets[ntets[i] .. ntets[i+1]-1] (CSR) */
+    int *tetv;        /* 4 per entry of tets: its extended points, contiguous (pn_pore_volumes) */
     int nthroat;
     int *tp;          /* 2*nthroat: pores i, j (q > 0 from i to j) */
     double *dx;       /* 3*nthroat: P_j(image) − P_i (the periodic image of j when across a periodic face) */
@@ -121,6 +124,9 @@ typedef struct {
     double *fsec;     /* 3*nthroat: w_f × sector area ½r²θ of each vertex (pressure force 3.10) */
     double *fvis;     /* 3*nthroat: w_f × A γ_k/γ of each vertex (viscous force 3.13–3.14) */
     int *wallf;       /* no-slip wall face in the throat (its share of the viscous force), -1 */
+    int *fsph;        /* 3*nthroat: sphere of each vertex of the facet */
+    double *fdir;     /* 9*nthroat: force on that sphere per unit pressure jump, (fsec + fvis) n,
+                         reflected for a mirror image (pn_forces without its parts) */
     /* statistics */
     double void_sum, solid_area_sum; /* Σ w φ_ij, Σ w γ_ij (partition checks) */
     double box_volume, solid_volume; /* box volume; Σ (4/3)π r³ of the spheres */
@@ -172,8 +178,9 @@ void pn_mean_velocity(const pn_domain_t *dom, const pn_net_t *net, const double 
 void pn_face_forces(const pn_domain_t *dom, const pn_net_t *net, const double *p, double F[6][3]);
 
 /* Fluid force on each sphere (3n, overwritten): pressure (3.10) + viscous
- * (3.13–3.14, along the flow).  fp / fv (may be NULL): the two parts.
- * Torque is zero: every part acts through the centre. */
+ * (3.13–3.14, along the flow).  fp / fv (may be NULL): the two parts (both
+ * or neither; without them the sum comes from the precomputed net->fdir, equal
+ * to round-off).  Torque is zero: every part acts through the centre. */
 void pn_forces(const pn_domain_t *dom, const pn_tri_t *t, const pn_net_t *net, const double *p, int n, double *f,
                double *fp, double *fv);
 
@@ -193,7 +200,8 @@ typedef struct {
     pn_solver_t *sol;
     int built;
     double *p, *vol, *vol_prev, *dvdt, *x_prev;
-    double *f, *fp, *fv;
+    int vol_current;    /* vol holds the pore volumes at x_prev on the current topology (the next step's start) */
+    double *f, *fp, *fv; /* fp, fv: filled by pn_write_snapshot only */
     double *x_cont;     /* previous positions continuous with the current ones (periodic unwrapping) */
     double *xid, *rid;  /* DEM coupling: positions / radii in the order of the particle ids (couple.c) */
     double dt_factor;   /* ζ of the coupled time step (thesis 4.21) */

@@ -70,6 +70,7 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
     m->built = 1;
     m->n_retri++;
     m->eps_acc = 0;
+    m->vol_current = 0;
     return 0;
 }
 
@@ -108,15 +109,26 @@ int pn_model_step(pn_model_t *m, int n, const double *x, const double *r, double
             m->x_cont[i] = xp;
         }
         /* rate of change of the pore volumes on the current topology, from
-         * the positions at the start and the end of the step (4.8) */
-        pn_pore_volumes(&m->dom, &m->tri, &m->net, m->x_cont, m->vol_prev);
+         * the positions at the start and the end of the step (4.8); the
+         * start's are the previous step's end volumes unless the topology
+         * was rebuilt since (x_cont = x_prev then: a periodic wrap rebuilds) */
+        if (m->vol_current) {
+            double *tmp = m->vol_prev;
+            m->vol_prev = m->vol;
+            m->vol = tmp;
+        } else {
+            pn_pore_volumes(&m->dom, &m->tri, &m->net, m->x_cont, m->vol_prev);
+        }
         pn_pore_volumes(&m->dom, &m->tri, &m->net, x, m->vol);
+        m->vol_current = 1;
         double emax = 0;
         for (int i = 0; i < np; i++) {
             m->dvdt[i] = (m->vol[i] - m->vol_prev[i]) / dt;
             if (m->vol_prev[i] > 0) emax = fmax(emax, fabs(m->vol[i] - m->vol_prev[i]) / m->vol_prev[i]);
         }
         m->eps_acc += emax;
+    } else {
+        m->vol_current = 0; /* x_prev becomes x, vol is not at x */
     }
     double t1 = cputime();
     int rc = pn_solve(m->sol, &m->dom, &m->net, moving ? m->dvdt : NULL, m->p);
@@ -126,7 +138,7 @@ int pn_model_step(pn_model_t *m, int n, const double *x, const double *r, double
                  pn_solver_iterations(m->sol));
         return -1;
     }
-    pn_forces(&m->dom, &m->tri, &m->net, m->p, n, m->f, m->fp, m->fv);
+    pn_forces(&m->dom, &m->tri, &m->net, m->p, n, m->f, NULL, NULL);
     m->t_vol += t1 - t0;
     m->t_solve += t2 - t1;
     m->t_force += cputime() - t2;
