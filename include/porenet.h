@@ -205,6 +205,7 @@ typedef struct {
     double *x_cont;     /* previous positions continuous with the current ones (periodic unwrapping) */
     double *xid, *rid;  /* DEM coupling: positions / radii in the order of the particle ids (couple.c) */
     double dt_factor;   /* ζ of the coupled time step (thesis 4.21) */
+    int dem_steps;      /* DEM steps per coupled step (multi-rate), within ζ Δt_{M−V} */
     double eps_acc;     /* accumulated pore strain since the last triangulation */
     long n_retri, n_steps;
     /* CPU times of the process (cputime(): the machine may be shared): last triangulation / network /
@@ -245,6 +246,9 @@ int pn_model_couple_dem(pn_model_t *m, struct dem *d, const double g[3], double 
  * limit of each mobile particle Δt_{M−V} = π ρ_k d_k²/(1200 μ) = M_k/(200 μ d_k)
  * (thesis 4.19–4.22, β = 400 calibrated for d_max/d_min ≤ 10). */
 double pn_coupled_dt(const pn_model_t *m, const struct dem *d);
+/* The coupled step of a run: porenet.dem_steps DEM steps, at most the limit
+ * pn_coupled_dt (docs/theory.md §8, multi-rate coupling). */
+double pn_coupled_step(const pn_model_t *m, const struct dem *d);
 
 /* Permeability along axis a: imposed-pressure faces on both ends of a
  * walled axis (κ = μ Q L/(ΔP S)), or a mean gradient on a periodic axis

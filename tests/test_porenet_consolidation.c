@@ -203,8 +203,8 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
     assert_int_equal(pn_model_couple_dem(&m, d, g0, 0.0), 0);
     set_load(d, o, sigma + dsig);
     if (getenv("PN_WET_DAMPING")) dem_set_damping(d, atof(getenv("PN_WET_DAMPING")));
-    /* one DEM step per coupled step, within the viscous limit (thesis 4.21) */
-    const double dt = fmin(pn_coupled_dt(&m, d), dem_dt(d));
+    /* porenet.dem_steps DEM steps per coupled step, within the viscous limit (thesis 4.21) */
+    const double dt = pn_coupled_step(&m, d);
     w.dt = dt;
     if (getenv("PN_TRACE") && mpi_rank() == 0)
         printf("# wet: dt %.3g s (viscous limit x dt_factor %.3g, DEM %.3g)\n", dt, pn_coupled_dt(&m, d), dem_dt(d));
@@ -277,10 +277,10 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
     w.retri = m.n_retri;
     if (mpi_rank() == 0) {
         const double us = 1e6 / w.steps;
-        printf("# %s: %ld steps, %ld triangulations (last: triangulation %.3g ms, network %.3g ms, factorisation "
+        printf("# %s: %ld steps of %.3g s, %d pores, %ld triangulations (last: triangulation %.3g ms, network %.3g ms, factorisation "
                "%.3g ms); per coupled step (CPU, us): DEM %.1f, volume rates %.1f, solve %.1f, forces %.1f, "
                "rebuilds amortised %.1f, gather/scatter %.1f; total %.1f\n",
-               label, w.steps, m.n_retri, 1e3 * m.t_tri, 1e3 * m.t_net, 1e3 * m.t_factor, t_dem * us, m.t_vol * us,
+               label, w.steps, dt, m.net.npore, m.n_retri, 1e3 * m.t_tri, 1e3 * m.t_net, 1e3 * m.t_factor, t_dem * us, m.t_vol * us,
                m.t_solve * us, m.t_force * us, m.t_rebuild * us,
                (t_couple - m.t_vol - m.t_solve - m.t_force - m.t_rebuild) * us, (t_dem + t_couple) * us);
     }
