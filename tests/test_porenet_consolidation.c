@@ -186,7 +186,7 @@ typedef struct {
 } wet_t;
 
 static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, double sigma, double dsig, double H,
-                     double L, double dH, double cv, double eps_retri, FILE *series, const char *label)
+                     double L, double dH, double cv, double eps_retri, int dem_steps, FILE *series, const char *label)
 {
     wet_t w = {0};
     dem_t *d = dem_create_from_config(cfg, MPI_COMM_WORLD);
@@ -199,6 +199,9 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
     pn_model_from_config(cfg, &m);
     m.dom.hi[2] = hnet;
     m.eps_retri = eps_retri;
+    if (dem_steps > 0) m.dem_steps = dem_steps;
+    /* PN_DT_FACTOR: ζ beyond the case file's range (stability measurements of the multi-rate step) */
+    if (getenv("PN_DT_FACTOR")) m.dt_factor = atof(getenv("PN_DT_FACTOR"));
     const double g0[3] = {0, 0, 0};
     assert_int_equal(pn_model_couple_dem(&m, d, g0, 0.0), 0);
     set_load(d, o, sigma + dsig);
@@ -416,7 +419,7 @@ static void test_consolidation(void **state)
         fprintf(series, "run,Tv,pmid,pbase,U,zmid_over_H,zbase_over_H\n");
     }
     const double eps_default = cfg_double(cfg, "porenet", "retriangulate");
-    const wet_t w = run_wet(cfg, s0, &o, hnet, sigma0, dsig, H, L, dH, cv, eps_default, series, "default");
+    const wet_t w = run_wet(cfg, s0, &o, hnet, sigma0, dsig, H, L, dH, cv, eps_default, 0, series, "default");
     if (mpi_rank() == 0) {
         printf("# consolidation: %d spheres (%d under the piston), H = %.4g m, E_oed = %.4g Pa (strain %.2e; from "
                "the piston %.4g Pa), kappa = %.4g m^2 (kappa/d^2 = %.3g), mu = %g Pa s, C_v = %.4g m^2/s, dt = %.3g s; "
@@ -449,7 +452,7 @@ static void test_consolidation(void **state)
         printf("# largest deviation from Terzaghi: %.4f (p_mid, p_base, U_corr); raw U: %.4f\n", dev, dev_raw);
     if (getenv("PN_REFERENCE")) {
         double worst = 0;
-        const wet_t e = run_wet(cfg, s0, &o, hnet, sigma0, dsig, H, L, dH, cv, 0.0, series, "every_step");
+        const wet_t e = run_wet(cfg, s0, &o, hnet, sigma0, dsig, H, L, dH, cv, 0.0, 0, series, "every_step");
         if (mpi_rank() == 0)
             printf("# re-triangulating every step: %ld triangulations, %.3g ms CPU per step\n", e.retri, 1e3 * e.t_step);
         for (int k = 0; k < ntv && k < e.ntv; k++) {
@@ -464,6 +467,30 @@ static void test_consolidation(void **state)
         /* §5.4: the default criterion agrees with every-step re-triangulation within 2 %
          * (measured only in the reference run: PN_REFERENCE=1, scripts/validate.sh) */
         assert_true(worst < 0.02);
+    }
+    {
+        /* multi-rate (docs/theory.md §8): twice the DEM steps per coupled step,
+         * the pressures solved every other DEM step.  The lag of the fluid force
+         * is O(Δt) against the consolidation time (≈ 7000 DEM steps): measured
+         * ≤ 6e-4 of Δσ (p) and 1.5e-4 of ΔH (U) at the T_v points with
+         * dem_steps = 2, 1.5e-3 with 4; the issue asks 1e-3 */
+        const int ms = 2 * cfg_int(cfg, "porenet", "dem_steps");
+        const wet_t e = run_wet(cfg, s0, &o, hnet, sigma0, dsig, H, L, dH, cv, eps_default, ms, series, "multirate");
+        double worst = 0;
+        for (int k = 0; k < ntv && k < e.ntv; k++) {
+            if (mpi_rank() == 0)
+                printf("#   dem_steps %d, T_v = %.1f: p_mid/dsigma = %.4f (default %.4f), p_base/dsigma = %.4f (default "
+                       "%.4f), U = %.4f (default %.4f)\n",
+                       ms, TV[k], e.pmid[k], w.pmid[k], e.pbase[k], w.pbase[k], e.U[k], w.U[k]);
+            worst = fmax(worst, fmax(fabs(e.pmid[k] - w.pmid[k]), fabs(e.U[k] - w.U[k])));
+            worst = fmax(worst, fabs(e.pbase[k] - w.pbase[k]));
+        }
+        if (mpi_rank() == 0)
+            printf("# multi-rate: %ld coupled steps, %.3g ms CPU per step (%.3g per DEM step); largest difference from "
+                   "the default (of Δσ, of ΔH) %.2e\n",
+                   e.steps, 1e3 * e.t_step, 1e3 * e.t_step / ms, worst);
+        assert_int_equal(e.ntv, ntv);
+        assert_true(worst < 1e-3);
     }
     if (series) fclose(series);
     /* the incompressible fluid takes the load step at once (undrained
