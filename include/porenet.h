@@ -74,16 +74,9 @@ typedef struct {
 
 /* Regular triangulation of n spheres (x: 3n, r: n) in the domain.  Returns 0,
  * or -1 with a reason in err (a centre inside another sphere or outside the
- * box, qhull failure).  margin <= 0: automatic (pn_triangulate_adaptive). */
+ * box, qhull failure).  margin <= 0: 3 maximum diameters. */
 int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double *r, double margin, pn_tri_t *t,
                    char *err, size_t nerr);
-/* The same with a margin per face fm[6] (in/out; <= 0: the automatic start, 3 diameters on a
- * periodic face, 1.5 on a wall).  adapt: the margins of the wall faces are widened (and the
- * triangulation redone) until every tetrahedron with its power centre in the box is exact — no
- * point left out could be closer to its power centre than √(ρ² + r_max²), ρ its orthoradius.
- * pn_triangulate: margin > 0 on every face, or margin <= 0 (automatic) with adapt. */
-int pn_triangulate_adaptive(const pn_domain_t *dom, int n, const double *x, const double *r, double fm[6], int adapt,
-                            pn_tri_t *t, char *err, size_t nerr);
 void pn_tri_free(pn_tri_t *t);
 /* Position of extended point `p` for sphere positions x (images follow their sphere). */
 void pn_tri_point(const pn_domain_t *dom, const pn_tri_t *t, const double *x, int p, double out[3]);
@@ -200,7 +193,6 @@ typedef struct {
     double pcg_tol;
     double eps_retri;   /* re-triangulate when Σ_steps max_i |ΔV_i/V_i| exceeds this (thesis 5.13–5.14); 0: every step */
     double margin;      /* image layer (0: auto) */
-    double face_margin[6]; /* automatic margins of the faces as widened by the rebuilds so far */
     double rho_f;       /* fluid density (Reynolds number, buoyancy) */
     int n;
     pn_tri_t tri;

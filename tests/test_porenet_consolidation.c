@@ -280,11 +280,10 @@ static wet_t run_wet(cfg_t *cfg, const char *s0, const oedo_t *o, double hnet, d
     w.retri = m.n_retri;
     if (mpi_rank() == 0) {
         const double us = 1e6 / w.steps;
-        printf("# %s: %ld steps of %.3g s, %d pores, %d points triangulated (margins %.3g %.3g %.3g %.3g %.3g %.3g m), %ld triangulations (last: triangulation %.3g ms, network %.3g ms, factorisation "
+        printf("# %s: %ld steps of %.3g s, %d pores, %ld triangulations (last: triangulation %.3g ms, network %.3g ms, factorisation "
                "%.3g ms); per coupled step (CPU, us): DEM %.1f, volume rates %.1f, solve %.1f, forces %.1f, "
                "rebuilds amortised %.1f, gather/scatter %.1f; total %.1f\n",
-               label, w.steps, dt, m.net.npore, m.tri.npts, m.face_margin[0], m.face_margin[1], m.face_margin[2],
-               m.face_margin[3], m.face_margin[4], m.face_margin[5], m.n_retri, 1e3 * m.t_tri, 1e3 * m.t_net, 1e3 * m.t_factor, t_dem * us, m.t_vol * us,
+               label, w.steps, dt, m.net.npore, m.n_retri, 1e3 * m.t_tri, 1e3 * m.t_net, 1e3 * m.t_factor, t_dem * us, m.t_vol * us,
                m.t_solve * us, m.t_force * us, m.t_rebuild * us,
                (t_couple - m.t_vol - m.t_solve - m.t_force - m.t_rebuild) * us, (t_dem + t_couple) * us);
     }

@@ -43,11 +43,7 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
     pn_network_free(&m->net);
     pn_tri_free(&m->tri);
     double t0 = cputime();
-    /* automatic margins: start from those the previous rebuilds needed */
-    if (m->margin > 0)
-        for (int f = 0; f < 6; f++) m->face_margin[f] = m->margin;
-    if (pn_triangulate_adaptive(&m->dom, n, x, r, m->face_margin, m->margin <= 0, &m->tri, m->err, sizeof m->err))
-        return -1;
+    if (pn_triangulate(&m->dom, n, x, r, m->margin, &m->tri, m->err, sizeof m->err)) return -1;
     double t1 = cputime();
     if (pn_network_build(&m->dom, &m->prm, &m->tri, x, r, n, &m->net, m->err, sizeof m->err)) return -1;
     double t2 = cputime();

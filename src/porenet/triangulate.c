@@ -112,81 +112,8 @@ int pn_fail(char *err, size_t nerr, const char *fmt, ...)
     return -1;
 }
 
-static int triangulate_faces(const pn_domain_t *dom, int n, const double *x, const double *r, const double fm[6],
-                             pn_tri_t *t, char *err, size_t nerr);
-
 int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double *r, double margin, pn_tri_t *t,
                    char *err, size_t nerr)
-{
-    double fm[6];
-    for (int f = 0; f < 6; f++) fm[f] = margin;
-    return pn_triangulate_adaptive(dom, n, x, r, fm, margin <= 0, t, err, nerr);
-}
-
-/* Largest sum of the orthoradius and r_max the tetrahedra whose power centre
- * is in the closed box need on the side of wall face f: a tetrahedron with
- * power centre P and orthoradius ρ (ρ² = |P − c_k|² − r_k², the same for its
- * four vertices) is one of the complete set's when no point left out has a
- * power distance below ρ² from P, i.e. when every point left out is farther
- * than √(ρ² + r_max²) from P.  The images left out across face f lie beyond
- * the plane at the margin m_f, at least (P_a − lo_a) + m_f from P: the
- * margin needed is √(ρ² + r_max²) − (P_a − lo_a).  The tetrahedra of the
- * pores on the wall planes are checked with the rest; by the mirror symmetry
- * the power cells of the box have no other corners on the walls. */
-static void margins_needed(const pn_domain_t *dom, const pn_tri_t *t, double rmax, const double fm[6], double need[6])
-{
-    const double tol = 1e-6 * rmax;
-    for (int f = 0; f < 6; f++) need[f] = 0;
-    for (int k = 0; k < t->ntet; k++) {
-        const double *P = t->P + 3 * k;
-        int in = 1;
-        for (int a = 0; a < 3 && in; a++) in = P[a] >= dom->lo[a] - tol && P[a] <= dom->hi[a] + tol;
-        if (!in) continue;
-        if (t->nbr[4 * k] < 0 || t->nbr[4 * k + 1] < 0 || t->nbr[4 * k + 2] < 0 || t->nbr[4 * k + 3] < 0) {
-            /* on the rim of the cloud (a thin layer, e.g. the symmetric sets of a lattice at the
-             * box's edges): half as wide again on every wall */
-            for (int f = 0; f < 6; f++) need[f] = fmax(need[f], 1.5 * fm[f]);
-            continue;
-        }
-        const int c0 = t->tet[4 * k];
-        double d2 = 0;
-        for (int a = 0; a < 3; a++) d2 += (P[a] - t->x[3 * c0 + a]) * (P[a] - t->x[3 * c0 + a]);
-        const double reach = sqrt(fmax(d2 - t->r[c0] * t->r[c0], 0.0) + rmax * rmax);
-        for (int a = 0; a < 3; a++) {
-            if (dom->periodic[a]) continue;
-            need[2 * a] = fmax(need[2 * a], reach - (P[a] - dom->lo[a]));
-            need[2 * a + 1] = fmax(need[2 * a + 1], reach - (dom->hi[a] - P[a]));
-        }
-    }
-}
-
-int pn_triangulate_adaptive(const pn_domain_t *dom, int n, const double *x, const double *r, double fm[6], int adapt,
-                            pn_tri_t *t, char *err, size_t nerr)
-{
-    double rmax = 0;
-    for (int i = 0; i < n; i++) rmax = fmax(rmax, r[i]);
-    for (int f = 0; f < 6; f++)
-        if (fm[f] <= 0) /* periodic faces 3 diameters; walls from 1.5 diameters, widened below when adapt */
-            fm[f] = dom->periodic[f / 2] || !adapt ? 6.0 * rmax : 3.0 * rmax;
-    for (int iter = 0;; iter++) {
-        if (triangulate_faces(dom, n, x, r, fm, t, err, nerr)) return -1;
-        if (!adapt || iter == 8) return 0;
-        double need[6];
-        margins_needed(dom, t, rmax, fm, need);
-        int widen = 0;
-        for (int f = 0; f < 6; f++) {
-            const double L = dom->hi[f / 2] - dom->lo[f / 2];
-            if (dom->periodic[f / 2] || need[f] <= fm[f] || fm[f] >= 0.99 * L) continue;
-            fm[f] = fmin(1.1 * need[f], 0.99 * L); /* 10 % more: the next rebuilds (which start from fm) rarely widen again */
-            widen = 1;
-        }
-        if (!widen) return 0;
-        pn_tri_free(t);
-    }
-}
-
-static int triangulate_faces(const pn_domain_t *dom, int n, const double *x, const double *r, const double fm[6],
-                             pn_tri_t *t, char *err, size_t nerr)
 {
     memset(t, 0, sizeof *t);
     if (n < 1) return pn_fail(err, nerr, "no spheres");
@@ -205,13 +132,12 @@ static int triangulate_faces(const pn_domain_t *dom, int n, const double *x, con
                             i, 'x' + a);
         }
     }
-    double margin = 0;
-    for (int f = 0; f < 6; f++) margin = fmax(margin, fm[f]);
+    if (margin <= 0) margin = 6.0 * rmax;
     t->margin = margin;
-    for (int f = 0; f < 6; f++)
-        if (fm[f] >= dom->hi[f / 2] - dom->lo[f / 2])
-            return pn_fail(err, nerr, "box length along %c (%g) is not larger than the image margin %g",
-                        'x' + f / 2, dom->hi[f / 2] - dom->lo[f / 2], fm[f]);
+    for (int a = 0; a < 3; a++)
+        if (margin >= dom->hi[a] - dom->lo[a])
+            return pn_fail(err, nerr, "box length along %c (%g) is not larger than the image margin %g (3 diameters)",
+                        'x' + a, dom->hi[a] - dom->lo[a], margin);
 
     /* ---- extended point set ---- */
     size_t cap = (size_t)n * 2 + 64, np = 0;
@@ -225,7 +151,7 @@ static int triangulate_faces(const pn_domain_t *dom, int n, const double *x, con
             int ok = 1;
             for (int a = 0; a < 3 && ok; a++) {
                 y[a] = image_coord(dom, a, sh[a], x[3 * i + a]);
-                if (sh[a] != 0 && !(y[a] > dom->lo[a] - fm[2 * a] && y[a] < dom->hi[a] + fm[2 * a + 1])) ok = 0;
+                if (sh[a] != 0 && !(y[a] > dom->lo[a] - margin && y[a] < dom->hi[a] + margin)) ok = 0;
             }
             if (!ok) continue;
             if (np == cap) {
