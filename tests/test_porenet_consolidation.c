@@ -21,6 +21,9 @@
  *     corrected zero d_s/ΔH; U_corr = (U − d_s/ΔH)/(1 − d_s/ΔH).  The ±0.05
  *     bound applies to p_mid, p_base and U_corr; the raw U is printed and
  *     bounded separately (docs/validation.md).
+ *  6. multi-rate: the saturated run again with twice porenet.dem_steps DEM
+ *     steps per coupled step; p_mid, p_base and U at the T_v points within
+ *     1e-3 of the first run (docs/theory.md §8).
  * Heights and settlements are those of the centres of the grains touching
  * the piston: the piston's own contacts, at the drained face, would add a
  * compliance that drains at once (not Terzaghi's).
