@@ -59,6 +59,8 @@ typedef struct {
     double *r;          /* radii */
     int *id;            /* index of the sphere in the input arrays */
     signed char *img;   /* 3*npts: per axis -1, 0, +1: periodic shift (× length) or mirror across lo / hi */
+    double *xm, *xo;    /* 3*npts: the image as an affine map of its sphere's centre, x_img = xm x + xo
+                           (xm = ±1; pn_tri_point, the pore volumes of every step) */
     /* Tetrahedra of the lower hull of the lifted points (all of them, images included). */
     int ntet;
     int *tet;           /* 4*ntet point indices */
@@ -108,6 +110,7 @@ typedef struct {
                          section(s) with the wall plane(s), pointing out of the box (0 inside) */
     double *bc_area;  /* area of the pore's section with its first wall face (PN_BC_FLUX shares) */
     int *ntets, *tets;/* tetrahedra of each pore: tets[ntets[i] .. ntets[i+1]-1] (CSR) */
+    int *tetv;        /* 4 per entry of tets: its extended points, contiguous (pn_pore_volumes) */
     int nthroat;
     int *tp;          /* 2*nthroat: pores i, j (q > 0 from i to j) */
     double *dx;       /* 3*nthroat: P_j(image) − P_i (the periodic image of j when across a periodic face) */
@@ -121,6 +124,9 @@ typedef struct {
     double *fsec;     /* 3*nthroat: w_f × sector area ½r²θ of each vertex (pressure force 3.10) */
     double *fvis;     /* 3*nthroat: w_f × A γ_k/γ of each vertex (viscous force 3.13–3.14) */
     int *wallf;       /* no-slip wall face in the throat (its share of the viscous force), -1 */
+    int *fsph;        /* 3*nthroat: sphere of each vertex of the facet */
+    double *fdir;     /* 9*nthroat: force on that sphere per unit pressure jump, (fsec + fvis) n,
+                         reflected for a mirror image (pn_forces without its parts) */
     /* statistics */
     double void_sum, solid_area_sum; /* Σ w φ_ij, Σ w γ_ij (partition checks) */
     double box_volume, solid_volume; /* box volume; Σ (4/3)π r³ of the spheres */
@@ -172,8 +178,9 @@ void pn_mean_velocity(const pn_domain_t *dom, const pn_net_t *net, const double 
 void pn_face_forces(const pn_domain_t *dom, const pn_net_t *net, const double *p, double F[6][3]);
 
 /* Fluid force on each sphere (3n, overwritten): pressure (3.10) + viscous
- * (3.13–3.14, along the flow).  fp / fv (may be NULL): the two parts.
- * Torque is zero: every part acts through the centre. */
+ * (3.13–3.14, along the flow).  fp / fv (may be NULL): the two parts (both
+ * or neither; without them the sum comes from the precomputed net->fdir, equal
+ * to round-off).  Torque is zero: every part acts through the centre. */
 void pn_forces(const pn_domain_t *dom, const pn_tri_t *t, const pn_net_t *net, const double *p, int n, double *f,
                double *fp, double *fv);
 
@@ -193,14 +200,18 @@ typedef struct {
     pn_solver_t *sol;
     int built;
     double *p, *vol, *vol_prev, *dvdt, *x_prev;
-    double *f, *fp, *fv;
+    int vol_current;    /* vol holds the pore volumes at x_prev on the current topology (the next step's start) */
+    double *f, *fp, *fv; /* fp, fv: filled by pn_write_snapshot only */
     double *x_cont;     /* previous positions continuous with the current ones (periodic unwrapping) */
     double *xid, *rid;  /* DEM coupling: positions / radii in the order of the particle ids (couple.c) */
     double dt_factor;   /* ζ of the coupled time step (thesis 4.21) */
+    int dem_steps;      /* DEM steps per coupled step (multi-rate), within ζ Δt_{M−V} */
     double eps_acc;     /* accumulated pore strain since the last triangulation */
     long n_retri, n_steps;
-    /* wall times: last triangulation / network / factorisation, cumulated solve and force times */
-    double t_tri, t_net, t_factor, t_solve, t_force, t_vol;
+    /* CPU times of the process (cputime(): the machine may be shared): last triangulation / network /
+     * factorisation, cumulated rebuilds (all three), volume rates, solves (right-hand side and
+     * back-substitution) and forces */
+    double t_tri, t_net, t_factor, t_rebuild, t_solve, t_force, t_vol;
     double *snap_time;  /* times of the snapshots written (output.c) */
     long *snap_counts;  /* points, tetrahedra, throats, spheres of each snapshot */
     int nsnap;
@@ -235,6 +246,9 @@ int pn_model_couple_dem(pn_model_t *m, struct dem *d, const double g[3], double 
  * limit of each mobile particle Δt_{M−V} = π ρ_k d_k²/(1200 μ) = M_k/(200 μ d_k)
  * (thesis 4.19–4.22, β = 400 calibrated for d_max/d_min ≤ 10). */
 double pn_coupled_dt(const pn_model_t *m, const struct dem *d);
+/* The coupled step of a run: porenet.dem_steps DEM steps, at most the limit
+ * pn_coupled_dt (docs/theory.md §8, multi-rate coupling). */
+double pn_coupled_step(const pn_model_t *m, const struct dem *d);
 
 /* Permeability along axis a: imposed-pressure faces on both ends of a
  * walled axis (κ = μ Q L/(ΔP S)), or a mean gradient on a periodic axis

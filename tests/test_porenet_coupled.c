@@ -59,7 +59,7 @@ static void test_deposition(void **state)
     assert_int_equal(dem_advance(d, dem_time(d)), DEM_OK); /* lists, forces and step of the initial state */
     assert_int_equal(pn_model_couple_dem(&m, d, g, 0.0), 0);
     /* the coupled step (driver rule: one DEM step within the viscous limit) */
-    const double dt = fmin(pn_coupled_dt(&m, d), dem_dt(d));
+    const double dt = pn_coupled_step(&m, d);
     const double dt_mv = pn_coupled_dt(&m, d) / m.dt_factor;
     int nstep = (int)ceil(t_end / dt);
     double mass_err = 0, mom_err = 0, gsum = 0;

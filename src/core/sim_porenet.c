@@ -156,8 +156,8 @@ static double part_stable_dt(void *ctx)
     porenet_part_t *pp = ctx;
     ensure_started(pp);
     if (!pp->with_dem) return INFINITY; /* a rigid skeleton sets no limit */
-    /* one DEM step per coupled step, within the viscous limit (thesis 4.21) */
-    return fmin(pn_coupled_dt(&pp->m, pp->d), dem_dt(pp->d));
+    /* porenet.dem_steps DEM steps per coupled step, within the viscous limit (thesis 4.21) */
+    return pn_coupled_step(&pp->m, pp->d);
 }
 
 static void part_advance(void *ctx, double dt)

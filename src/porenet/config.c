@@ -32,6 +32,9 @@ static const cfg_key_t porenet_keys[] = {
      "re-triangulate when the accumulated largest pore volume strain exceeds this (thesis 5.13-5.14); 0: every step"},
     {"porenet", "dt_factor", CFG_DOUBLE, "0.8", 1e-6, 1, NULL,
      "with DEM particles: time step = dt_factor x the viscous limit pi rho d^2/(1200 mu) (thesis 4.20-4.22)"},
+    {"porenet", "dem_steps", CFG_INT, "1", 1, 1000, NULL,
+     "with DEM particles: DEM steps per coupled step (multi-rate: the pressures are solved and the fluid forces "
+     "updated every dem_steps DEM steps); the coupled step stays within dt_factor x the viscous limit"},
     {"porenet", "margin", CFG_DOUBLE, "0", 0, BIG, NULL,
      "width of the layer of sphere images across the faces (m); 0: 3 largest diameters"},
     {"porenet", "packing", CFG_STRING, NULL, 1, 0, NULL,
@@ -86,4 +89,5 @@ void pn_model_from_config(cfg_t *cfg, pn_model_t *m)
     m->eps_retri = cfg_double(cfg, "porenet", "retriangulate");
     m->margin = cfg_double(cfg, "porenet", "margin");
     m->dt_factor = cfg_double(cfg, "porenet", "dt_factor");
+    m->dem_steps = cfg_int(cfg, "porenet", "dem_steps");
 }

@@ -47,3 +47,8 @@ double pn_coupled_dt(const pn_model_t *m, const dem_t *d)
         if (!fixed[i]) lim = fmin(lim, dem_mass(d, i) / (200.0 * m->prm.mu * 2.0 * r[i])); /* (4.20) */
     return m->dt_factor * lim;
 }
+
+double pn_coupled_step(const pn_model_t *m, const dem_t *d)
+{
+    return fmin(pn_coupled_dt(m, d), (m->dem_steps > 1 ? m->dem_steps : 1) * dem_dt(d));
+}

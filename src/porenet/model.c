@@ -42,16 +42,17 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
     m->sol = NULL;
     pn_network_free(&m->net);
     pn_tri_free(&m->tri);
-    double t0 = wtime();
+    double t0 = cputime();
     if (pn_triangulate(&m->dom, n, x, r, m->margin, &m->tri, m->err, sizeof m->err)) return -1;
-    double t1 = wtime();
+    double t1 = cputime();
     if (pn_network_build(&m->dom, &m->prm, &m->tri, x, r, n, &m->net, m->err, sizeof m->err)) return -1;
-    double t2 = wtime();
+    double t2 = cputime();
     m->sol = pn_solver_create(&m->dom, &m->net, m->kind, m->pcg_tol, m->err, sizeof m->err);
     if (!m->sol) return -1;
     m->t_tri = t1 - t0;
     m->t_net = t2 - t1;
-    m->t_factor = wtime() - t2;
+    m->t_factor = cputime() - t2;
+    m->t_rebuild += cputime() - t0;
     int np = m->net.npore;
     m->p = realloc(m->p, (size_t)np * sizeof *m->p);
     m->vol = realloc(m->vol, (size_t)np * sizeof *m->vol);
@@ -69,6 +70,7 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
     m->built = 1;
     m->n_retri++;
     m->eps_acc = 0;
+    m->vol_current = 0;
     return 0;
 }
 
@@ -93,7 +95,7 @@ int pn_model_step(pn_model_t *m, int n, const double *x, const double *r, double
         if (pn_model_rebuild(m, n, x, r)) return -1;
     }
     int np = m->net.npore;
-    double t0 = wtime();
+    double t0 = cputime();
     if (moving) {
         /* previous positions continuous with x (periodic unwrapping: the
          * topology now follows x) */
@@ -107,28 +109,39 @@ int pn_model_step(pn_model_t *m, int n, const double *x, const double *r, double
             m->x_cont[i] = xp;
         }
         /* rate of change of the pore volumes on the current topology, from
-         * the positions at the start and the end of the step (4.8) */
-        pn_pore_volumes(&m->dom, &m->tri, &m->net, m->x_cont, m->vol_prev);
+         * the positions at the start and the end of the step (4.8); the
+         * start's are the previous step's end volumes unless the topology
+         * was rebuilt since (x_cont = x_prev then: a periodic wrap rebuilds) */
+        if (m->vol_current) {
+            double *tmp = m->vol_prev;
+            m->vol_prev = m->vol;
+            m->vol = tmp;
+        } else {
+            pn_pore_volumes(&m->dom, &m->tri, &m->net, m->x_cont, m->vol_prev);
+        }
         pn_pore_volumes(&m->dom, &m->tri, &m->net, x, m->vol);
+        m->vol_current = 1;
         double emax = 0;
         for (int i = 0; i < np; i++) {
             m->dvdt[i] = (m->vol[i] - m->vol_prev[i]) / dt;
             if (m->vol_prev[i] > 0) emax = fmax(emax, fabs(m->vol[i] - m->vol_prev[i]) / m->vol_prev[i]);
         }
         m->eps_acc += emax;
+    } else {
+        m->vol_current = 0; /* x_prev becomes x, vol is not at x */
     }
-    double t1 = wtime();
+    double t1 = cputime();
     int rc = pn_solve(m->sol, &m->dom, &m->net, moving ? m->dvdt : NULL, m->p);
-    double t2 = wtime();
+    double t2 = cputime();
     if (rc) {
         snprintf(m->err, sizeof m->err, "PCG did not reach porenet.pcg_tol = %g in %d iterations", m->pcg_tol,
                  pn_solver_iterations(m->sol));
         return -1;
     }
-    pn_forces(&m->dom, &m->tri, &m->net, m->p, n, m->f, m->fp, m->fv);
+    pn_forces(&m->dom, &m->tri, &m->net, m->p, n, m->f, NULL, NULL);
     m->t_vol += t1 - t0;
     m->t_solve += t2 - t1;
-    m->t_force += wtime() - t2;
+    m->t_force += cputime() - t2;
     memcpy(m->x_prev, x, 3 * (size_t)n * sizeof *x);
     m->n_steps++;
     return 0;

@@ -60,6 +60,9 @@ void pn_network_free(pn_net_t *n)
     free(n->fsec);
     free(n->fvis);
     free(n->wallf);
+    free(n->tetv);
+    free(n->fsph);
+    free(n->fdir);
     memset(n, 0, sizeof *n);
 }
 
@@ -593,6 +596,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
     net->ntets[0] = 0;
     for (int p = 0; p < np; p++) net->ntets[p + 1] = net->ntets[p] + cstart[proot[p] + 1] - cstart[proot[p]];
     net->tets = malloc((size_t)net->ntets[np] * sizeof(int));
+    net->tetv = malloc(4 * (size_t)net->ntets[np] * sizeof(int));
     for (int p = 0; p < np; p++) {
         int c = proot[p];
         memcpy(net->P + 3 * p, cP + 3 * c, 3 * sizeof(double));
@@ -612,6 +616,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
             int tt = clist[q];
             net->tets[m] = tt;
             const int *v = t->tet + 4 * tt;
+            memcpy(net->tetv + 4 * m, v, 4 * sizeof *v);
             const double *X = t->x;
             vt += fabs(tet_volume(X + 3 * v[0], X + 3 * v[1], X + 3 * v[2], X + 3 * v[3]));
             for (int i = 0; i < 4; i++) {
@@ -728,6 +733,18 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
         }
     }
     if (prm->wall_model == PN_WALL_YADE) wall_throats_yade(dom, prm, t, net, tplane);
+    /* force on each vertex's sphere per unit pressure jump (pn_forces): a
+     * mirror image gives its force reflected across the wall */
+    net->fsph = malloc(3 * (size_t)nth * sizeof(int));
+    net->fdir = malloc(9 * (size_t)nth * sizeof(double));
+    for (int f = 0; f < nth; f++)
+        for (int v = 0; v < 3; v++) {
+            const int q = tfv[3 * f + v];
+            const double c = net->fsec[3 * f + v] + net->fvis[3 * f + v];
+            net->fsph[3 * f + v] = t->id[q];
+            for (int a = 0; a < 3; a++)
+                net->fdir[9 * f + 3 * v + a] = ((!dom->periodic[a] && t->img[3 * q + a]) ? -c : c) * net->nrm[3 * f + a];
+        }
     for (int p = 0; p < np; p++)
         if (net->face[p] >= 0) net->bc_area[p] = fabs(net->sect[3 * p + net->face[p] / 2]);
     net->box_volume = 1.0;
@@ -753,7 +770,7 @@ void pn_pore_volumes(const pn_domain_t *dom, const pn_tri_t *t, const pn_net_t *
     for (int p = 0; p < net->npore; p++) {
         double v = 0;
         for (int m = net->ntets[p]; m < net->ntets[p + 1]; m++) {
-            const int *q = t->tet + 4 * net->tets[m];
+            const int *q = net->tetv + 4 * m;
             double c[4][3];
             for (int i = 0; i < 4; i++) pn_tri_point(dom, t, x, q[i], c[i]);
             v += fabs(tet_volume(c[0], c[1], c[2], c[3]));

@@ -154,6 +154,12 @@ void pn_write_snapshot(pn_model_t *m, const double *x, const char *dir, double t
         hsize_t s2[2] = {(hsize_t)m->n, 3}, s1 = (hsize_t)m->n;
         write_ds(g3, "position", H5T_NATIVE_DOUBLE, 2, s2, x);
         write_ds(g3, "force", H5T_NATIVE_DOUBLE, 2, s2, m->f);
+        {
+            /* the two parts (the steps compute their sum only) */
+            double *fs = malloc(3 * (size_t)m->n * sizeof *fs);
+            pn_forces(&m->dom, t, net, m->p, m->n, fs, m->fp, m->fv);
+            free(fs);
+        }
         write_ds(g3, "force_pressure", H5T_NATIVE_DOUBLE, 2, s2, m->fp);
         write_ds(g3, "force_viscous", H5T_NATIVE_DOUBLE, 2, s2, m->fv);
         write_ds(g3, "radius", H5T_NATIVE_DOUBLE, 1, &s1, rad);

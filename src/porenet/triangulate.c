@@ -39,6 +39,8 @@ void pn_tri_free(pn_tri_t *t)
     free(t->r);
     free(t->id);
     free(t->img);
+    free(t->xm);
+    free(t->xo);
     free(t->tet);
     free(t->nbr);
     free(t->P);
@@ -57,8 +59,11 @@ static double image_coord(const pn_domain_t *dom, int a, int s, double v)
 
 void pn_tri_point(const pn_domain_t *dom, const pn_tri_t *t, const double *x, int p, double out[3])
 {
+    (void)dom;
+    /* image_coord as an affine map: v + s L and 2 lo − v (or 2 hi − v) are
+     * reproduced bit for bit by 1·v + s L and −1·v + 2 lo */
     const double *c = x + 3 * (size_t)t->id[p];
-    for (int a = 0; a < 3; a++) out[a] = image_coord(dom, a, t->img[3 * p + a], c[a]);
+    for (int a = 0; a < 3; a++) out[a] = t->xm[3 * p + a] * c[a] + t->xo[3 * p + a];
 }
 
 /* Orthocentre of 4 weighted points: 2(c_k − c_0)·P = |c_k|² − |c_0|² − (r_k² − r_0²),
@@ -164,6 +169,14 @@ int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double 
         }
     }
     t->npts = (int)np;
+    t->xm = malloc(3 * np * sizeof *t->xm);
+    t->xo = malloc(3 * np * sizeof *t->xo);
+    for (size_t p = 0; p < np; p++)
+        for (int a = 0; a < 3; a++) {
+            const int s = IMG[3 * p + a];
+            t->xm[3 * p + a] = (s != 0 && !dom->periodic[a]) ? -1.0 : 1.0;
+            t->xo[3 * p + a] = s == 0 ? 0.0 : dom->periodic[a] ? s * (dom->hi[a] - dom->lo[a]) : s < 0 ? 2.0 * dom->lo[a] : 2.0 * dom->hi[a];
+        }
     t->x = X;
     t->r = R;
     t->id = ID;
