@@ -63,7 +63,11 @@ void fluid_divergence_scaled(const fluid_t *f, double scale, double *div)
  * fluid_apply_bc) and, for x, when the last local plane borders a wall.
  * The cells next to a wall are also where the quadratic-ghost wall terms
  * change u* after the sweep, so they are never in the interior. */
-fluid_interior_t fluid_interior(const grid_t *g)
+typedef struct {
+    int ilo, ihi, jlo, jhi, klo, khi;
+} fluid_interior_t;
+
+static fluid_interior_t fluid_interior(const grid_t *g)
 {
     fluid_interior_t b;
     b.ilo = 1;
@@ -75,6 +79,47 @@ fluid_interior_t fluid_interior(const grid_t *g)
     return b;
 }
 
+/* What a pass split by fluid_interior computes on a block of cells: the
+ * scaled divergence of uu into div, or (div NULL) max |D u| and the
+ * convective rate of f->u into m. */
+typedef struct {
+    const double *const *uu;
+    double scale, *div, *m;
+} split_pass_t;
+
+static void div_cfl_block(const fluid_t *f, double *m, int i, int j0, int j1, int k0, int k1);
+
+static void split_block(const fluid_t *f, const split_pass_t *sp, int i, int j0, int j1, int k0, int k1)
+{
+    if (sp->div) div_block(f, sp->uu, sp->scale, sp->div, i, j0, j1, k0, k1);
+    else div_cfl_block(f, sp->m, i, j0, j1, k0, k1);
+}
+
+/* the interior cells of plane i */
+static void split_interior_plane(const fluid_t *f, const split_pass_t *sp, int i)
+{
+    fluid_interior_t b = fluid_interior(f->g);
+    if (i >= b.ilo && i < b.ihi) split_block(f, sp, i, b.jlo, b.jhi, b.klo, b.khi);
+}
+
+/* every cell outside the interior */
+static void split_rest(const fluid_t *f, const split_pass_t *sp)
+{
+    const grid_t *g = f->g;
+    fluid_interior_t b = fluid_interior(g);
+    int ny = g->n[1], nz = g->n[2];
+    for (int i = 0; i < g->nxl; i++) {
+        if (i < b.ilo || i >= b.ihi) {
+            split_block(f, sp, i, 0, ny, 0, nz);
+            continue;
+        }
+        split_block(f, sp, i, 0, b.jlo, 0, nz);
+        split_block(f, sp, i, b.jhi, ny, 0, nz);
+        split_block(f, sp, i, b.jlo, b.jhi, 0, b.klo);
+        split_block(f, sp, i, b.jlo, b.jhi, b.khi, nz);
+    }
+}
+
 /* Fused divergence (docs/theory.md §1, step 1.1): a sweep that writes u plane by plane
  * calls this once plane i of every component is final, while the plane is
  * still in cache; fluid_divergence_rest completes the field once the ghosts
@@ -82,26 +127,13 @@ fluid_interior_t fluid_interior(const grid_t *g)
  * expression per cell). */
 void fluid_divergence_interior_plane(const fluid_t *f, const double *const uu[3], double scale, double *div, int i)
 {
-    fluid_interior_t b = fluid_interior(f->g);
-    if (i >= b.ilo && i < b.ihi) div_block(f, uu, scale, div, i, b.jlo, b.jhi, b.klo, b.khi);
+    split_interior_plane(f, &(split_pass_t){.uu = uu, .scale = scale, .div = div}, i);
 }
 
 void fluid_divergence_rest(const fluid_t *f, double scale, double *div)
 {
-    const grid_t *g = f->g;
     const double *uu[3] = {f->u[0], f->u[1], f->u[2]};
-    fluid_interior_t b = fluid_interior(g);
-    int ny = g->n[1], nz = g->n[2];
-    for (int i = 0; i < g->nxl; i++) {
-        if (i < b.ilo || i >= b.ihi) {
-            div_block(f, uu, scale, div, i, 0, ny, 0, nz);
-            continue;
-        }
-        div_block(f, uu, scale, div, i, 0, b.jlo, 0, nz);
-        div_block(f, uu, scale, div, i, b.jhi, ny, 0, nz);
-        div_block(f, uu, scale, div, i, b.jlo, b.jhi, 0, b.klo);
-        div_block(f, uu, scale, div, i, b.jlo, b.jhi, b.khi, nz);
-    }
+    split_rest(f, &(split_pass_t){.uu = uu, .scale = scale, .div = div});
 }
 
 void fluid_divergence(const fluid_t *f, double *div) { fluid_divergence_scaled(f, 1.0, div); }
@@ -163,26 +195,10 @@ static void div_cfl_block(const fluid_t *f, double *m, int i, int j0, int j1, in
  * ghosts are filled.  A maximum does not depend on the order. */
 void fluid_div_cfl_interior_plane(const fluid_t *f, int i, double *m)
 {
-    fluid_interior_t b = fluid_interior(f->g);
-    if (i >= b.ilo && i < b.ihi) div_cfl_block(f, m, i, b.jlo, b.jhi, b.klo, b.khi);
+    split_interior_plane(f, &(split_pass_t){.m = m}, i);
 }
 
-void fluid_div_cfl_rest(const fluid_t *f, double *m)
-{
-    const grid_t *g = f->g;
-    fluid_interior_t b = fluid_interior(g);
-    int ny = g->n[1], nz = g->n[2];
-    for (int i = 0; i < g->nxl; i++) {
-        if (i < b.ilo || i >= b.ihi) {
-            div_cfl_block(f, m, i, 0, ny, 0, nz);
-            continue;
-        }
-        div_cfl_block(f, m, i, 0, b.jlo, 0, nz);
-        div_cfl_block(f, m, i, b.jhi, ny, 0, nz);
-        div_cfl_block(f, m, i, b.jlo, b.jhi, 0, b.klo);
-        div_cfl_block(f, m, i, b.jlo, b.jhi, b.khi, nz);
-    }
-}
+void fluid_div_cfl_rest(const fluid_t *f, double *m) { split_rest(f, &(split_pass_t){.m = m}); }
 
 double fluid_max_divergence(const fluid_t *f)
 {

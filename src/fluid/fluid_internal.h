@@ -95,10 +95,6 @@ void fluid_update_diagnostics(fluid_t *f, const double *stats, const double *div
 /* Fused divergence and diagnostics (3-D): the cells whose stencil reads only
  * unknowns of this rank, computed by a sweep as soon as a plane is final, and
  * the rest computed after the ghosts are filled; see diagnostics.c. */
-typedef struct {
-    int ilo, ihi, jlo, jhi, klo, khi;
-} fluid_interior_t;
-fluid_interior_t fluid_interior(const grid_t *g);
 void fluid_divergence_interior_plane(const fluid_t *f, const double *const uu[3], double scale, double *div, int i);
 void fluid_divergence_rest(const fluid_t *f, double scale, double *div);
 void fluid_div_cfl_interior_plane(const fluid_t *f, int i, double *m);
