@@ -184,7 +184,8 @@ static const cfg_key_t lub_keys[] = {
     {"lubrication", "subtract_resolved", CFG_BOOL, "false", 1, 0, NULL,
      "subtract the force at the activation distance (the part a resolved fluid already carries)"},
     {"lubrication", "overlap", CFG_ENUM, "off", 1, 0, "off|saturated",
-     "while the particles overlap: off, or saturated (the force keeps its delta = 0 value, film at eta_e: eq. 3.26)"},
+     "lubrication while the particles overlap: off (decision 5), or saturated (the force keeps its delta = 0 value "
+     "-6 pi eta_f R^2 u_n / eta_e: the contact damping of eq. 3.26)"},
     {"lubrication", "walls", CFG_BOOL, "true", 1, 0, NULL, "also between a particle and a wall"},
     {"lubrication", "viscosity", CFG_DOUBLE, "-1", -1, 1e12, NULL,
      "dynamic viscosity eta_f (Pa s); -1: rho nu of the [fluid] section"},
