@@ -264,6 +264,21 @@ static dem_t *make_overlap(int wall, const char *mode, int subtract, double mu, 
 /* Restitution of the oscillator δ'' + 2β δ' + K δ = 0 from δ = 0 back to δ = 0: exp(−β π/ω_d). */
 static double oscillator_restitution(double K, double beta) { return exp(-beta * M_PI / sqrt(K - beta * beta)); }
 
+/* One DEM step; the gap and the approach speed after it (particle 0 and the wall, or particles 0 and 1). */
+static void overlap_step(dem_t *d, int wall, double *gap, double *u)
+{
+    assert_int_equal(dem_step(d), DEM_OK);
+    const double *x = dem_positions(d), *v = dem_velocities(d);
+    if (wall) {
+        *gap = x[2] - R;
+        *u = -v[2];
+    } else {
+        const int a = dem_ids(d)[0] == 0 ? 0 : 1, b = 1 - a;
+        *gap = x[3 * b + 2] - x[3 * a + 2] - 2 * R;
+        *u = v[3 * a + 2] - v[3 * b + 2];
+    }
+}
+
 /* Normal collision with the wall (wall != 0) or of two equal spheres head-on, starting in the film at
  * gap 0.02 R with approach speed u0.  Returns u_off/u_on, the approach speeds when the overlap opens and
  * closes.  They are taken from the last step before the overlap and the first after it (gap δ > 0 at both
@@ -287,30 +302,12 @@ static double overlap_collision(int wall, const char *mode, int subtract, double
     const double L0 = Lpot(0.0, OV_ETA, OV_RANGE, subtract);
     double gap_prev = gap_start, u_prev = u0, u_on = NAN, u_off = NAN;
     for (long s = 0; s < 100L * nc && isnan(u_off); s++) {
-        assert_int_equal(dem_step(d), DEM_OK);
-        const double *x = dem_positions(d), *v = dem_velocities(d);
-        double gap, u; /* gap and approach speed */
-        if (wall) {
-            gap = x[2] - R;
-            u = -v[2];
-        } else {
-            const int a = dem_ids(d)[0] == 0 ? 0 : 1, b = 1 - a;
-            gap = x[3 * b + 2] - x[3 * a + 2] - 2 * R;
-            u = v[3 * a + 2] - v[3 * b + 2];
-        }
+        double gap, u;
+        overlap_step(d, wall, &gap, &u);
         if (gap_prev > 0 && gap <= 0 && isnan(u_on)) u_on = u_prev - kl * (Lpot(gap_prev, OV_ETA, OV_RANGE, subtract) - L0);
         if (gap_prev <= 0 && gap > 0 && !isnan(u_on)) {
             /* the first step that ends outside may have started inside: take the next one */
-            assert_int_equal(dem_step(d), DEM_OK);
-            const double *x2 = dem_positions(d), *v2 = dem_velocities(d);
-            if (wall) {
-                gap = x2[2] - R;
-                u = -v2[2];
-            } else {
-                const int a = dem_ids(d)[0] == 0 ? 0 : 1, b = 1 - a;
-                gap = x2[3 * b + 2] - x2[3 * a + 2] - 2 * R;
-                u = v2[3 * a + 2] - v2[3 * b + 2];
-            }
+            overlap_step(d, wall, &gap, &u);
             assert_true(gap > 0);
             u_off = -(u - kl * (Lpot(gap, OV_ETA, OV_RANGE, subtract) - L0));
         }
