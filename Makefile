@@ -3,7 +3,9 @@
 #   make test       install missing Debian packages, build, run the test suite (1 and 2 ranks)
 #   make demo       install, build, run the built-in demo case and plot it
 #   make validate   full-size validation cases (long)
-#   make restitution  restitution sweeps of issue 5 (wall and binary; ~20 min on 2 cores)
+#   make restitution  restitution sweeps of issue 5 (wall and binary; ~20 min on 2 cores);
+#                   RESTITUTION_SET='section.key=value ...' overrides keys in every run,
+#                   RESTITUTION_OUT=dir the output directory (default build/restitution)
 #   make bench      benchmarks, results appended to docs/performance.md
 #   make deps       install missing Debian packages (apt-get)
 #   SANITIZE=1      build with AddressSanitizer + UBSan into build-san/
@@ -84,9 +86,10 @@ bench: deps
 
 # restitution curves of the bouncing sphere and the binary collision (issue 5): the sweep in
 # parallel on the available cores, build/restitution/{restitution,binary}.{csv,png}, target checks
+RESTITUTION_OUT ?= $(BUILD)/restitution
 restitution: deps
 	@$(MAKE) --no-print-directory all
-	@BUILD=$(BUILD) bash scripts/restitution.sh $(BUILD)/restitution full
+	@BUILD=$(BUILD) bash scripts/restitution.sh $(RESTITUTION_OUT) full $(RESTITUTION_SET)
 
 clean:
 	rm -rf build build-san

@@ -153,7 +153,7 @@ def finish(fig, ax, xlim, xlabel, ylabel, title, path):
     fig.savefig(path, dpi=110)
 
 
-def plot_wall(wall, path):
+def plot_wall(wall, path, note=""):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -180,10 +180,10 @@ def plot_wall(wall, path):
                 label=r"Gondret/Joseph $\varepsilon/\varepsilon_{max}\approx0.6$ at $St\approx60$")
     plot_runs(ax, wall, "St", "epsilon_over_max", COLOURS)
     finish(fig, ax, (0.5, 3000), r"$St = (\rho_p+\rho/2) V_T D / 9\eta_f$", r"$\varepsilon/\varepsilon_{max}$",
-           "Sphere bouncing on a wall (axisymmetric, D/Δx = 10, η_e/R = 2e-4)", path)
+           "Sphere bouncing on a wall (axisymmetric, D/Δx = 10, η_e/R = 2e-4)" + note, path)
 
 
-def plot_binary(pair, path):
+def plot_binary(pair, path, note=""):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -205,7 +205,7 @@ def plot_binary(pair, path):
     ax.axvspan(5, 20, ymin=0, ymax=0.04, color="tab:olive", alpha=0.6, label="experimental $St_c$ 5–20")
     plot_runs(ax, pair, "St_B", "epsilon_B", {8: "tab:blue", 2.3: "tab:green", 90: "tab:red"})
     finish(fig, ax, (1, 3e4), r"$St_B = \rho_p U_i D / 9\eta_f$", r"$\varepsilon_B$",
-           "Binary collision on the axis (D/Δx = 20, η_e/R = 2e-4)", path)
+           "Binary collision on the axis (D/Δx = 20, η_e/R = 2e-4)" + note, path)
 
 
 def check(out, wall, pair, missing):
@@ -265,6 +265,14 @@ def check(out, wall, pair, missing):
     return fails
 
 
+def overrides_note(out):
+    """The key=value overrides of the sweep (restitution_cases.py), for the figure titles."""
+    sets = {}
+    for mf in glob.glob(os.path.join(out, "*", "meta.json")):
+        sets.update(json.load(open(mf)).get("overrides", {}))
+    return "".join(f", {k} = {v}" for k, v in sorted(sets.items()))
+
+
 def main():
     out = sys.argv[1]
     wall, pair, missing = collect(out)
@@ -272,8 +280,9 @@ def main():
     write_csv(os.path.join(out, "binary.csv"), pair)
     print(f"{len(wall)} wall runs -> {out}/restitution.csv, {len(pair)} binary runs -> {out}/binary.csv")
     if "--no-plot" not in sys.argv:
-        if wall: plot_wall(wall, os.path.join(out, "restitution.png"))
-        if pair: plot_binary(pair, os.path.join(out, "binary.png"))
+        note = overrides_note(out)
+        if wall: plot_wall(wall, os.path.join(out, "restitution.png"), note)
+        if pair: plot_binary(pair, os.path.join(out, "binary.png"), note)
     if "--no-check" not in sys.argv:
         sys.exit(1 if check(out, wall, pair, missing) else 0)
 

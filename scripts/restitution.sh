@@ -6,8 +6,10 @@
 # rho_p/rho = 2.3 at St_B = 7 and 90 at St_B = 1352; D/dx = 20).  Runs in parallel, one rank each,
 # nice'd, on JOBS cores (default: nproc).  Then postproc/restitution.py writes OUT/restitution.csv,
 # OUT/binary.csv, OUT/restitution.png, OUT/binary.png and checks the targets (PASS/FAIL lines;
-# exit status 1 if a target fails).  The run list: scripts/restitution_cases.py.
-# usage: scripts/restitution.sh [OUT=build/restitution] [full|coarse]
+# exit status 1 if a target fails).  The run list: scripts/restitution_cases.py.  Further arguments
+# key=value are `--set` overrides given to every run after the run list's own (e.g.
+# lubrication.overlap=saturated); `make restitution RESTITUTION_SET='key=value ...' RESTITUTION_OUT=dir`.
+# usage: scripts/restitution.sh [OUT=build/restitution] [full|coarse] [key=value ...]
 set -e
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 OUT=$(realpath -m "${1:-$ROOT/build/restitution}")
@@ -18,7 +20,7 @@ export IBMDEM=$ROOT/${BUILD:-build}/ibmdem
 [ -x "$IBMDEM" ] || { echo "$IBMDEM missing: make all first" >&2; exit 1; }
 rm -rf "$OUT"
 mkdir -p "$OUT"
-$PY "$ROOT/scripts/restitution_cases.py" "$OUT" "$MODE"
+$PY "$ROOT/scripts/restitution_cases.py" "$OUT" "$MODE" "${@:3}"
 start=$(date +%s)
 xargs -P "$JOBS" -n 1 nice -n 5 bash < "$OUT/jobs.list"
 cpu=$(cat "$OUT"/*.time 2>/dev/null | awk '{s += $1 + $2} END {printf "%.0f", s}')

@@ -7,7 +7,10 @@ St = (rho_p/rho + 1/2) Re_p / 9 (eq. 3.19); the measured St is what is plotted.
 Binary runs: cases/binary_collision/binary_axi.ini (units D = U_o = rho = 1), nu chosen so that
 St_B = (rho_p/rho) Re_rel / 9 (eq. 3.34) hits the target with the measured U_i/U_o.
 
-usage: restitution_cases.py OUT full|coarse
+Further arguments key=value override (or add) a case-file key in every run, after the run list's own
+settings (e.g. lubrication.overlap=saturated); they are recorded in each run's meta.json.
+
+usage: restitution_cases.py OUT full|coarse [key=value ...]
 """
 import json
 import math
@@ -163,14 +166,28 @@ def runs(out, mode):
     return r
 
 
+def overrides(args):
+    """key=value arguments as a dict (section.key = value, as for --set)."""
+    sets = {}
+    for a in args:
+        key, eq, value = a.partition("=")
+        if not eq or "." not in key:
+            sys.exit(f"override {a!r}: expected section.key=value")
+        sets[key.strip()] = value.strip()
+    return sets
+
+
 def main():
     out, mode = sys.argv[1], sys.argv[2]
+    extra = overrides(sys.argv[3:])
     os.makedirs(os.path.join(out, "jobs"), exist_ok=True)
     exe = os.environ.get("IBMDEM", os.path.join(ROOT, "build/ibmdem"))
     listing = []
     total = 0.0
     for name, d, ini, sets, meta in sorted(runs(out, mode), key=lambda r: -r[4]["cost"]):
         total += meta["cost"]
+        sets.update(extra)
+        if extra: meta["overrides"] = extra
         os.makedirs(d, exist_ok=True)
         with open(os.path.join(d, "meta.json"), "w") as f: json.dump(meta, f, indent=1)
         cmd = [exe, "run", ini, "--out", d] + [a for k, v in sets.items() for a in ("--set", f"{k}={v}")]

@@ -40,11 +40,13 @@ typedef struct {
 
 /* Brenner (1961) normal lubrication with an effective roughness (Izard eq.
  * 2.36/3.18, decision 5; lubrication.c): between particles and between a
- * particle and a wall, active for 0 < δ_n ≤ Δ_lub, off while they overlap. */
+ * particle and a wall, active for 0 < δ_n ≤ Δ_lub; while they overlap off, or
+ * with overlap = saturated at its δ_n = 0 value (eq. 3.26). */
 typedef struct {
     int on;
     int walls;           /* also between a particle and a wall */
     int subtract;        /* subtract the force at δ_n = Δ_lub (the part the grid resolves) */
+    int overlap;         /* [lubrication] overlap = saturated: the δ_n = 0 force while overlapping */
     double viscosity;    /* η_f (Pa s) */
     double roughness;    /* η_e / R */
     double range;        /* Δ_lub / R */

@@ -3,8 +3,14 @@
  *
  *     F_lub = − 6π η_f (u_i − u_j)·n (R_i R_j/(R_i + R_j))² / (δ_n + η_e)  n,
  *
- * with R_i R_j/(R_i + R_j) → R_i against a wall, active for 0 < δ_n ≤ Δ_lub
- * and off while the particles overlap (δ_n ≤ 0, where the contact law acts).
+ * with R_i R_j/(R_i + R_j) → R_i against a wall, active for 0 < δ_n ≤ Δ_lub.
+ * While the particles overlap (δ_n ≤ 0, where the contact law acts),
+ * [lubrication] overlap chooses:
+ *  - off (default; decision 5): no lubrication force;
+ *  - saturated: the force keeps its δ_n = 0 value, F = −6π η_f R_eff² u_n/η_e
+ *    (film thickness frozen at η_e), i.e. the contact gains the constant
+ *    damping 6π η_f R²/η_e of eq. 3.26 of the seed.  The force is then
+ *    continuous at δ_n = 0.
  * η_e = roughness × R and Δ_lub = range × R with R = min(R_i, R_j) (the
  * particle's radius against a wall).  Optionally the force at δ_n = Δ_lub is
  * subtracted (1/(δ + η_e) − 1/(Δ_lub + η_e)): that part of the film the grid
@@ -15,13 +21,17 @@
  * interval depends only on the gaps at its ends,
  *     J = −k [L(δ₁) − L(δ₀)],   L(δ) = ln(clamp(δ, 0, Δ_lub) + η_e)
  *                                       [− clamp(δ, 0, Δ_lub)/(Δ_lub + η_e)],
- * the clamp switching the force off outside (0, Δ_lub].  The DEM applies
+ * the clamp switching the force off outside (0, Δ_lub].  With overlap =
+ * saturated L continues below δ = 0 along its tangent,
+ *     L(δ) = ln η_e + δ (1/η_e [− 1/(Δ_lub + η_e)]),   δ < 0,
+ * (C¹ at δ = 0, so the force is continuous there; unbounded below, which
+ * only changes the bracket of the solve, see lub_solve).  The DEM applies
  * this impulse to the half-step velocities just before the drift, with δ₁
  * the gap the drift will produce, δ₁ = δ₀ − Δt u′ (u′ the approach speed
  * after the impulse): a scalar equation per pair,
  *     m* (u′ − u) + k [L(δ₀) − L(δ₀ − Δt u′)] = 0,
  * whose left side increases strictly with u′, so it has one root, found by
- * safeguarded Newton iterations in a bracket of width 2kΔL/m*.  The scheme is
+ * safeguarded Newton iterations in a bracket (lub_solve).  The scheme is
  * implicit (unconditionally stable: a pair can never be pushed through
  * δ = −η_e by its own lubrication, whatever η_e/R and Δt), and for a lone
  * pair it keeps u − (k/m*) L(δ) constant exactly, the first integral of the
@@ -43,28 +53,52 @@
 
 typedef struct {
     double eta, range, sub; /* η_e, Δ_lub, 1/(Δ_lub + η_e) or 0 */
+    int overlap;            /* overlap = saturated: L continues linearly below δ = 0 */
 } lub_pair_t;
 
-/* L(δ) of the header. */
+/* L(δ) of the header (continued linearly below δ = 0 with overlap = saturated). */
 static inline double lub_potential(const lub_pair_t *p, double delta)
 {
+    if (delta < 0 && p->overlap) return log(p->eta) + delta * (1.0 / p->eta - p->sub);
     const double c = delta < 0 ? 0 : delta > p->range ? p->range : delta;
     return log(c + p->eta) - c * p->sub;
 }
 
-/* dL/dδ (0 outside the active range). */
+/* dL/dδ (0 outside the active range; its δ = 0 value below 0 with overlap = saturated). */
 static inline double lub_potential_slope(const lub_pair_t *p, double delta)
 {
-    if (delta <= 0 || delta >= p->range) return 0.0;
+    if (delta >= p->range || (delta <= 0 && !p->overlap)) return 0.0;
+    if (delta <= 0) return 1.0 / p->eta - p->sub;
     return 1.0 / (delta + p->eta) - p->sub;
 }
 
-/* Root u′ of m (u′ − u) + k [L(δ₀) − L(δ₀ − dt u′)] = 0. */
+/* Root u′ of g(u′) = m (u′ − u) + k [L(δ₀) − L(δ₀ − dt u′)] = 0.
+ *
+ * Bracket.  g′ = m + k dt L′ ≥ m, and g(0) = −m u, so the root lies between
+ * 0 and u (the impulse never reverses the approach) and within |g(u)|/m of
+ * u: between u and u − g(u)/m, the explicit impulse over the undamped drift.
+ * With overlap = off L is bounded and the original bracket u ± k ΔL/m (ΔL =
+ * L(Δ_lub) − L(0)), which contains both, is kept with its tolerance scale:
+ * `off` stays bit-identical to the code before the option existed.  With
+ * overlap = saturated L is unbounded below (linear for δ < 0), so only the
+ * tight bracket is finite: the interval between u and
+ * clamp(u − g(u)/m, between 0 and u), tolerance scale |u|. */
 static double lub_solve(const lub_pair_t *p, double m, double k, double dt, double gap0, double u)
 {
     const double L0 = lub_potential(p, gap0);
-    const double width = k * (lub_potential(p, p->range) - lub_potential(p, 0.0)) / m;
-    double lo = u - width, hi = u + width, x = u;
+    double lo, hi, scale;
+    if (!p->overlap) {
+        scale = k * (lub_potential(p, p->range) - lub_potential(p, 0.0)) / m;
+        lo = u - scale;
+        hi = u + scale;
+    } else {
+        const double explicit_u = u - k * (L0 - lub_potential(p, gap0 - dt * u)) / m;
+        const double far = u > 0 ? fmax(explicit_u, 0.0) : fmin(explicit_u, 0.0);
+        lo = fmin(u, far);
+        hi = fmax(u, far);
+        scale = fabs(u);
+    }
+    double x = u;
     for (int it = 0; it < 200; it++) {
         const double g = m * (x - u) + k * (L0 - lub_potential(p, gap0 - dt * x));
         if (g == 0) return x;
@@ -75,7 +109,7 @@ static double lub_solve(const lub_pair_t *p, double m, double k, double dt, doub
         const double dg = m + k * dt * lub_potential_slope(p, gap0 - dt * x);
         double xn = x - g / dg;
         if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
-        if (fabs(xn - x) <= 1e-15 * (fabs(x) + width) || hi - lo <= 1e-15 * (fabs(x) + width)) return xn;
+        if (fabs(xn - x) <= 1e-15 * (fabs(x) + scale) || hi - lo <= 1e-15 * (fabs(x) + scale)) return xn;
         x = xn;
     }
     return x;
@@ -86,6 +120,7 @@ static inline void lub_params(const dem_lub_t *L, double R, lub_pair_t *p)
     p->eta = L->roughness * R;
     p->range = L->range * R;
     p->sub = L->subtract ? 1.0 / (p->range + p->eta) : 0.0;
+    p->overlap = L->overlap;
 }
 
 void dem_lubrication_impulses(dem_t *d, double dt)
@@ -105,7 +140,7 @@ void dem_lubrication_impulses(dem_t *d, double dt)
             lub_pair_t p;
             lub_params(L, ri < rj ? ri : rj, &p);
             const double u = dem_pair_approach(d, i, j, n), gap1 = gap0 - dt * u;
-            if ((gap0 >= p.range && gap1 >= p.range) || (gap0 <= 0 && gap1 <= 0)) continue;
+            if ((gap0 >= p.range && gap1 >= p.range) || (!p.overlap && gap0 <= 0 && gap1 <= 0)) continue;
             const double m = 1.0 / (invm[i] + invm[j]), reff = ri * rj / (ri + rj);
             const double du = lub_solve(&p, m, k0 * reff * reff, dt, gap0, u) - u; /* change of the approach speed */
             const double J = m * du;                                                /* impulse along n on i */
@@ -129,7 +164,7 @@ void dem_lubrication_impulses(dem_t *d, double dt)
                 const double gap0 = dem_wall_gap(d, W, i, &u), gap1 = gap0 - dt * u;
                 lub_pair_t p;
                 lub_params(L, r[i], &p);
-                if ((gap0 >= p.range && gap1 >= p.range) || (gap0 <= 0 && gap1 <= 0)) continue;
+                if ((gap0 >= p.range && gap1 >= p.range) || (!p.overlap && gap0 <= 0 && gap1 <= 0)) continue;
                 const double m = 1.0 / invm[i];
                 const double du = lub_solve(&p, m, k0 * r[i] * r[i], dt, gap0, u) - u;
                 /* the approach speed changes by du: v changes by −du n */
@@ -148,6 +183,9 @@ static const cfg_key_t lub_keys[] = {
     {"lubrication", "range", CFG_DOUBLE, "0.5", 1e-6, 10, NULL, "activation distance Delta_lub / R (gap 0 < delta <= Delta_lub)"},
     {"lubrication", "subtract_resolved", CFG_BOOL, "false", 1, 0, NULL,
      "subtract the force at the activation distance (the part a resolved fluid already carries)"},
+    {"lubrication", "overlap", CFG_ENUM, "off", 1, 0, "off|saturated",
+     "lubrication while the particles overlap: off (decision 5), or saturated (the force keeps its delta = 0 value "
+     "-6 pi eta_f R^2 u_n / eta_e: the contact damping of eq. 3.26)"},
     {"lubrication", "walls", CFG_BOOL, "true", 1, 0, NULL, "also between a particle and a wall"},
     {"lubrication", "viscosity", CFG_DOUBLE, "-1", -1, 1e12, NULL,
      "dynamic viscosity eta_f (Pa s); -1: rho nu of the [fluid] section"},
@@ -166,6 +204,7 @@ void dem_lubrication_config(dem_t *d, cfg_t *cfg)
     L->range = cfg_double(cfg, "lubrication", "range");
     L->subtract = cfg_bool(cfg, "lubrication", "subtract_resolved");
     L->walls = cfg_bool(cfg, "lubrication", "walls");
+    L->overlap = cfg_enum(cfg, "lubrication", "overlap") == 1;
     L->viscosity = cfg_double(cfg, "lubrication", "viscosity");
     if (L->viscosity < 0) {
         if (!cfg_has_section(cfg, "fluid"))
