@@ -94,6 +94,9 @@ void field_zero(const grid_t *g, double *f);
  * (ghosts included) with the neighbour ranks / periodic image.  Ghosts at a
  * non-periodic face are left for the boundary conditions. */
 void grid_halo_yz(const grid_t *g, double *f);
+/* the periodic y/z copies of the x planes ilo..ihi only (each plane's
+ * ghosts come from the same plane) */
+void grid_halo_yz_planes(const grid_t *g, double *f, int ilo, int ihi);
 void grid_halo_x(const grid_t *g, double *f);
 void grid_halo(const grid_t *g, double *f);
 

@@ -106,6 +106,13 @@ void poisson_apply(poisson_t *p, double lambda, double *x, double *y);
 /* Fill the ghosts of x with the homogeneous BCs of this location (after a
  * halo exchange). */
 void poisson_fill_ghosts(const poisson_t *p, double *x);
+/* The same in two parts, for a field whose x planes become final one after
+ * another: the ghosts of the edge planes (0 and nxl−1: their y/z ghosts, the
+ * x halo, the ghost planes), then those of an inner plane i (1..nxl−2,
+ * which no other plane's ghosts read).  Together they set every ghost to
+ * the value poisson_fill_ghosts gives. */
+void poisson_fill_ghosts_edges(const poisson_t *p, double *x);
+void poisson_fill_ghosts_plane(const poisson_t *p, double *x, int i);
 
 /* Is (i,j,k) (local) an unknown of this location? */
 int poisson_is_unknown(const poisson_t *p, int i, int j, int k);

@@ -196,7 +196,7 @@ static void line_coefs(const fluid_t *f, int c, int i, double adt, coef_t *k)
  * US[c] (= H_old on entry, read only when st->dz ≠ 0).  Ghosts of u must be
  * valid. */
 static void rhs_sweep(const fluid_t *f, const stage_t *st, double adt, double *const H[3], double *const US[3],
-                      double div_scale, double *div)
+                      double div_scale, double *div, const fluid_ahead_t *ahead)
 {
     const grid_t *g = f->g;
     const double *u = f->u[0], *v = f->u[1], *w = g->dim == 3 ? f->u[2] : NULL;
@@ -213,6 +213,8 @@ static void rhs_sweep(const fluid_t *f, const stage_t *st, double adt, double *c
     double *nous[3] = {NULL, NULL, NULL};
     double *const *us = fused ? US : nous;
     for (int i = 0; i < g->nxl; i++) {
+        /* the planes of u and p this plane reads (i − 1 … i + 1) made final */
+        if (ahead) ahead->fn(ahead->ctx, i);
         coef_t k[3];
         for (int c = 0; c < nc; c++) line_coefs(f, c, i, adt, &k[c]);
         int nl = is3d ? g->n[1] : 1;
@@ -249,21 +251,22 @@ static void wall_ghost_terms(const fluid_t *f, double cv, double dg, double ce, 
 void fluid_rhs(const fluid_t *f, double ca, double cv, double *const out[3])
 {
     stage_t st = {.ca = ca, .cv = cv, .p = f->p};
-    rhs_sweep(f, &st, 0.0, out, NULL, 0.0, NULL);
+    rhs_sweep(f, &st, 0.0, out, NULL, 0.0, NULL, NULL);
     wall_ghost_terms(f, cv, 0.0, 0.0, out, NULL);
 }
 
 void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
                        double *const H[3], double *const US[3])
 {
-    fluid_rhs_predict_div(f, ca, cv, dg, dz, adt, ce, H, US, 0.0, NULL);
+    fluid_rhs_predict_div(f, ca, cv, dg, dz, adt, ce, H, US, 0.0, NULL, NULL);
 }
 
 void fluid_rhs_predict_div(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
-                           double *const H[3], double *const US[3], double div_scale, double *div)
+                           double *const H[3], double *const US[3], double div_scale, double *div,
+                           const fluid_ahead_t *ahead)
 {
     stage_t st = {.ca = ca, .cv = cv, .dg = dg, .dz = dz, .ce = ce, .p = f->p};
-    rhs_sweep(f, &st, adt, H, US, div_scale, f->g->dim == 3 ? div : NULL);
+    rhs_sweep(f, &st, adt, H, US, div_scale, f->g->dim == 3 ? div : NULL, ahead);
     /* the wall terms change u* next to walls only: cells fluid_interior leaves out */
     wall_ghost_terms(f, cv, dg, ce, H, US);
 }

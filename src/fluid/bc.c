@@ -53,14 +53,15 @@ static void halo_x_fields(const fluid_t *f, double *const *u, int nf)
         for (int c = 0; c < nf; c++) memcpy(u[c] + off_hi, rb + c * np, bytes);
 }
 
-/* Boundary ghosts of component c (after the halo exchange). */
-static void fill_boundary_ghosts(const fluid_t *f, int c, double *u)
+/* x-face ghosts of component c (after the halo exchange): the ghost planes
+ * from planes 0 and nxl−1, u on the boundary face. */
+static void fill_x_face_ghosts(const fluid_t *f, int c, double *u)
 {
     const grid_t *g = f->g;
     const bc_t *bc = &g->bc;
     int nxl = g->nxl, ny = g->n[1], nz = g->n[2], gz = g->gz;
 
-    /* x faces: only the ranks that own them */
+    /* only the ranks that own them */
     if (!g->periodic[0]) {
         for (int s = 0; s < 2; s++) {
             if ((s == 0 && g->left != MPI_PROC_NULL) || (s == 1 && g->right != MPI_PROC_NULL)) continue;
@@ -79,9 +80,18 @@ static void fill_boundary_ghosts(const fluid_t *f, int c, double *u)
                 }
         }
     }
+}
+
+/* y- and z-face ghosts of component c on the x planes ilo..ihi: each plane's
+ * from the same plane, y before z (the z ghosts of the y ghost rows last). */
+static void fill_yz_face_ghosts(const fluid_t *f, int c, double *u, int ilo, int ihi)
+{
+    const grid_t *g = f->g;
+    const bc_t *bc = &g->bc;
+    int ny = g->n[1], nz = g->n[2], gz = g->gz;
     /* y faces (every rank, ghost planes in x included) */
     if (!g->periodic[1]) {
-        for (int i = -1; i <= nxl; i++)
+        for (int i = ilo; i <= ihi; i++)
             for (int k = -gz; k < nz + gz; k++) {
                 if (c == 1) {
                     u[G_IDX(g, i, -1, k)] = 0.0;
@@ -96,7 +106,7 @@ static void fill_boundary_ghosts(const fluid_t *f, int c, double *u)
     }
     /* z faces */
     if (g->dim == 3 && !g->periodic[2]) {
-        for (int i = -1; i <= nxl; i++)
+        for (int i = ilo; i <= ihi; i++)
             for (int j = -1; j <= ny; j++) {
                 if (c == 2) {
                     u[G_IDX(g, i, j, -1)] = 0.0;
@@ -113,10 +123,43 @@ static void fill_boundary_ghosts(const fluid_t *f, int c, double *u)
 
 void fluid_apply_bc(fluid_t *f)
 {
-    int nc = fluid_ncomp(f->g);
-    for (int c = 0; c < nc; c++) grid_halo_yz(f->g, f->u[c]);
+    const grid_t *g = f->g;
+    int nc = fluid_ncomp(g);
+    for (int c = 0; c < nc; c++) grid_halo_yz(g, f->u[c]);
     halo_x_fields(f, f->u, nc);
-    for (int c = 0; c < nc; c++) fill_boundary_ghosts(f, c, f->u[c]);
+    for (int c = 0; c < nc; c++) {
+        fill_x_face_ghosts(f, c, f->u[c]);
+        fill_yz_face_ghosts(f, c, f->u[c], -1, g->nxl);
+    }
+}
+
+/* fluid_apply_bc in two parts (for u^k corrected plane by plane, step.c): the
+ * ghosts the edge planes 0 and nxl−1 determine — their own, the x halo and
+ * the ghost planes —, then those of an inner plane i, which only plane i
+ * determines.  The same operations as fluid_apply_bc on the same values, so
+ * every ghost ends with the value fluid_apply_bc gives. */
+void fluid_apply_bc_edges(fluid_t *f)
+{
+    const grid_t *g = f->g;
+    int nc = fluid_ncomp(g);
+    for (int c = 0; c < nc; c++) {
+        grid_halo_yz_planes(g, f->u[c], -1, 0);
+        grid_halo_yz_planes(g, f->u[c], g->nxl - 1, g->nxl);
+    }
+    halo_x_fields(f, f->u, nc);
+    for (int c = 0; c < nc; c++) {
+        fill_x_face_ghosts(f, c, f->u[c]);
+        fill_yz_face_ghosts(f, c, f->u[c], -1, 0);
+        fill_yz_face_ghosts(f, c, f->u[c], g->nxl - 1, g->nxl);
+    }
+}
+
+void fluid_apply_bc_plane(fluid_t *f, int i)
+{
+    for (int c = 0; c < fluid_ncomp(f->g); c++) {
+        grid_halo_yz_planes(f->g, f->u[c], i, i);
+        fill_yz_face_ghosts(f, c, f->u[c], i, i);
+    }
 }
 
 /* The pressure (and its correction φ) has zero normal gradient at walls and

@@ -74,9 +74,17 @@ void fluid_rhs(const fluid_t *f, double ca, double cv, double *const out[3]);
 void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
                        double *const H[3], double *const US[3]);
 /* the same, also div = div_scale · D u* on the interior cells (3-D,
- * fluid_interior; the caller completes it with fluid_divergence_rest) */
+ * fluid_interior; the caller completes it with fluid_divergence_rest), and
+ * with `ahead` (or NULL) called before each x plane i is swept: it must
+ * leave planes i − 1 … i + 1 of u and p final, ghosts included (step.c's
+ * deferred correction) */
+typedef struct {
+    void (*fn)(void *ctx, int i);
+    void *ctx;
+} fluid_ahead_t;
 void fluid_rhs_predict_div(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
-                           double *const H[3], double *const US[3], double div_scale, double *div);
+                           double *const H[3], double *const US[3], double div_scale, double *div,
+                           const fluid_ahead_t *ahead);
 /* viscous.c */
 void fluid_laplacian_add(const fluid_t *f, int c, const double *u, double scale, double *out);
 void fluid_wall_terms_add(const fluid_t *f, int c, double scale, double *out);
@@ -84,6 +92,9 @@ void fluid_wall_ghost_add(const fluid_t *f, int c, const double *u, double scale
 void fluid_viscous_setup(fluid_t *f);
 /* bc.c */
 void fluid_fill_pressure_ghosts(const fluid_t *f, double *p);
+/* fluid_apply_bc in parts: the edge planes' ghosts, then an inner plane's */
+void fluid_apply_bc_edges(fluid_t *f);
+void fluid_apply_bc_plane(fluid_t *f, int i);
 /* timestep.c: max over cells of Σ_d |u_d|/Δ_d (|u_d| the larger of the two faces) */
 double fluid_convective_rate(const fluid_t *f);
 /* diagnostics.c: ke, div_max, cfl of f->diag from the current field (stats:

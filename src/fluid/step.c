@@ -30,55 +30,69 @@ static inline double grad_rdx(const grid_t *g, int c, int i)
     return c == 0 ? 1.0 / g->dxc[i] : c == 1 ? 1.0 / g->dy : 1.0 / g->dz;
 }
 
-/* u^k = u* − α Δt G φ on the unknowns of every component.  The sweep runs
- * plane by plane and line by line with the components inside (as the
- * right-hand side sweep of advection.c), so that each line of φ is read from
- * memory once for the three components.  With `stats`, also accumulate
- * Σ V u² (stats[0]) and max |u| (stats[1]) of the projected field for the
- * diagnostics.  With `fuse_p` the pressure update p += φ (explicit viscous
- * terms) is done on the lines of u, whose unknowns are the pressure cells
- * except the plane beyond an x wall (left to the caller). */
+/* u^k = u* − α Δt G φ on the unknowns of every component of x plane i,
+ * line by line with the components inside (as the right-hand side sweep of
+ * advection.c), so that each line of φ is read from memory once for the
+ * three components.  With `ei`, also accumulate Σ u² per component (ei) and
+ * max |u| (*um) of the projected field for the diagnostics.  With `fuse_p`
+ * the pressure update p += φ (explicit viscous terms) is done on the lines of
+ * u, whose unknowns are the pressure cells except the plane beyond an x wall
+ * (pressure_plane_add). */
+static inline void correct_plane(fluid_t *f, const double *restrict ph, double dt_stage, int fuse_p, int i,
+                                 double *ei, double *um)
+{
+    const grid_t *g = f->g;
+    int nc = fluid_ncomp(g), is3d = g->dim == 3;
+    double *restrict p = f->p;
+    int nl = is3d ? g->n[1] : 1;
+    for (int jl = 0; jl < nl; jl++)
+        for (int c = 0; c < nc; c++) {
+            if (i >= fluid_iend(g, c) || (is3d && jl >= fluid_nu(g, c, 1))) continue;
+            double *restrict u = f->u[c];
+            long c0 = G_IDX(g, i, jl, 0), len = is3d ? fluid_nu(g, c, 2) : fluid_nu(g, c, 1), s = grad_stride(g, c);
+            double ac = dt_stage * grad_rdx(g, c, i);
+            if (!ei)
+                for (long m = c0; m < c0 + len; m++) u[m] -= ac * (ph[m + s] - ph[m]);
+            else {
+                double e = ei[c], x_max = *um;
+                for (long m = c0; m < c0 + len; m++) {
+                    double x = u[m] - ac * (ph[m + s] - ph[m]);
+                    u[m] = x;
+                    e += x * x;
+                    x_max = dmax(x_max, fabs(x));
+                }
+                ei[c] = e;
+                *um = x_max;
+            }
+            if (c == 0 && fuse_p)
+                for (long m = c0; m < c0 + len; m++) p[m] += ph[m];
+        }
+}
+
+/* p += φ on x plane i (the planes correct_plane leaves: beyond an x wall) */
+static void pressure_plane_add(fluid_t *f, const double *restrict ph, int i)
+{
+    const grid_t *g = f->g;
+    double *restrict p = f->p;
+    FLUID_FOR_LINES(g, i, g->n[1], g->n[2], c0, len)
+    for (long m = c0; m < c0 + len; m++) p[m] += ph[m];
+}
+
+/* The correction of every plane, with the diagnostics' sums (`stats`: Σ V u²
+ * in stats[0], max |u| in stats[1]) and, plane by plane once u^k is final
+ * there, its part of max |D u| and of the convective rate (div_cfl; the rest
+ * once the ghosts are filled). */
 static void correct_velocity(fluid_t *f, const double *restrict ph, double dt_stage, int fuse_p, double *stats,
                              double *div_cfl)
 {
     const grid_t *g = f->g;
-    int nc = fluid_ncomp(g), is3d = g->dim == 3;
-    int iend[3], nj[3], nk[3];
-    long sp[3];
+    int nc = fluid_ncomp(g);
     double e[3] = {0.0, 0.0, 0.0}, um = stats ? stats[1] : 0.0;
-    for (int c = 0; c < nc; c++) {
-        iend[c] = fluid_iend(g, c);
-        nj[c] = fluid_nu(g, c, 1);
-        nk[c] = fluid_nu(g, c, 2);
-        sp[c] = grad_stride(g, c);
-    }
-    double *restrict p = f->p;
     for (int i = 0; i < g->nxl; i++) {
-        double a[3], ei[3] = {0.0, 0.0, 0.0};
-        for (int c = 0; c < nc; c++) a[c] = dt_stage * grad_rdx(g, c, i);
-        int nl = is3d ? g->n[1] : 1;
-        for (int jl = 0; jl < nl; jl++)
-            for (int c = 0; c < nc; c++) {
-                if (i >= iend[c] || (is3d && jl >= nj[c])) continue;
-                double *restrict u = f->u[c];
-                long c0 = G_IDX(g, i, jl, 0), len = is3d ? nk[c] : nj[c], s = sp[c];
-                double ac = a[c];
-                if (!stats)
-                    for (long m = c0; m < c0 + len; m++) u[m] -= ac * (ph[m + s] - ph[m]);
-                else
-                    for (long m = c0; m < c0 + len; m++) {
-                        double x = u[m] - ac * (ph[m + s] - ph[m]);
-                        u[m] = x;
-                        ei[c] += x * x;
-                        um = dmax(um, fabs(x));
-                    }
-                if (c == 0 && fuse_p)
-                    for (long m = c0; m < c0 + len; m++) p[m] += ph[m];
-            }
+        double ei[3] = {0.0, 0.0, 0.0};
+        correct_plane(f, ph, dt_stage, fuse_p, i, stats ? ei : NULL, &um);
         if (stats)
             for (int c = 0; c < nc; c++) e[c] += fluid_cell_volume(f, c, i) * ei[c];
-        /* plane i of u^k is final: its part of the diagnostics' max |D u| and
-         * convective rate (the rest once the ghosts are filled) */
         if (div_cfl) fluid_div_cfl_interior_plane(f, i, div_cfl);
     }
     if (stats) {
@@ -91,12 +105,12 @@ static void correct_velocity(fluid_t *f, const double *restrict ph, double dt_st
  * (the fused sweep of fluid_step).  div_cfl (3-D, or NULL): receives this
  * rank's max |D u^k| and convective rate, computed in the correction sweep
  * and completed after the ghost fill. */
-static void project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats, int div_ready,
-                          double *div_cfl)
+/* The pressure correction φ of a stage into q->work, ghosts filled:
+ * L φ = D(u*)/(αΔt), solved in place (div_ready: q->work already holds the
+ * right-hand side). */
+static double *solve_correction(fluid_t *f, double dt_stage, int div_ready)
 {
-    const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
-    /* the right-hand side D(u*)/(αΔt), then φ: solved in place */
     double *phi = q->work;
     if (!div_ready) fluid_divergence_scaled(f, 1.0 / dt_stage, phi);
     if (poisson_solve(q->pp, 0.0, phi, phi) != 0)
@@ -104,6 +118,15 @@ static void project_stage(fluid_t *f, double dt_stage, int update_pressure, doub
     f->diag.res_poisson = q->pp->last_residual;
     f->diag.it_poisson = q->pp->last_iterations;
     fluid_fill_pressure_ghosts(f, phi);
+    return phi;
+}
+
+static void project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats, int div_ready,
+                          double *div_cfl)
+{
+    const grid_t *g = f->g;
+    fluid_priv_t *q = fluid_priv(f);
+    double *phi = solve_correction(f, dt_stage, div_ready);
     /* u −= α Δt G φ [and p += φ with explicit viscous terms], one sweep */
     int fuse_p = update_pressure && !f->prm.implicit_viscous;
     correct_velocity(f, phi, dt_stage, fuse_p, stats, div_cfl);
@@ -133,14 +156,59 @@ static void project_stage(fluid_t *f, double dt_stage, int update_pressure, doub
             }
         } else {
             /* p += φ on the planes the sweep of u above did not cover */
-            for (int i = fluid_iend(g, 0); i < g->nxl; i++)
-                FLUID_FOR_LINES(g, i, g->n[1], g->n[2], c0, len)
-                for (long m = c0; m < c0 + len; m++) f->p[m] += phi[m];
+            for (int i = fluid_iend(g, 0); i < g->nxl; i++) pressure_plane_add(f, phi, i);
         }
         fluid_fill_pressure_ghosts(f, f->p);
     }
     fluid_apply_bc(f);
     if (div_cfl) fluid_div_cfl_rest(f, div_cfl);
+}
+
+/* The correction of stage k deferred into the predictor sweep of stage k + 1
+ * (theory §1, step 1.5): u^k = u* − αΔt G φ and p += φ are applied to x plane
+ * i + 1 just before the sweep reaches plane i, so the corrected planes are
+ * still in cache when the predictor reads them, instead of a sweep of their
+ * own over u, p and φ.  The edge planes 0 and nxl − 1 go first, since the x
+ * halo and the ghost planes (read by the sweep's first and last planes) come
+ * from them; an inner plane's ghosts come from that plane only.  The same
+ * operations on the same values as project_stage: bit-identical.  φ stays in
+ * q->work, where the sweep writes D u* of plane i after planes i and i + 1 are
+ * corrected: plane i of φ is no longer read by then (the correction of plane i'
+ * reads φ at i' and i' + 1). */
+typedef struct {
+    fluid_t *f;
+    const double *phi;
+    double dt_stage;
+    int next; /* first inner plane not yet corrected */
+} deferred_correction_t;
+
+static void deferred_plane(deferred_correction_t *d, int i)
+{
+    correct_plane(d->f, d->phi, d->dt_stage, 1, i, NULL, NULL);
+    if (i >= fluid_iend(d->f->g, 0)) pressure_plane_add(d->f, d->phi, i);
+}
+
+static void deferred_start(deferred_correction_t *d)
+{
+    fluid_t *f = d->f;
+    int nxl = f->g->nxl;
+    deferred_plane(d, 0);
+    if (nxl > 1) deferred_plane(d, nxl - 1);
+    poisson_fill_ghosts_edges(fluid_priv(f)->pp, f->p);
+    fluid_apply_bc_edges(f);
+    d->next = 1;
+}
+
+/* fluid_ahead_t: planes up to i + 1 final before the sweep reads them */
+static void deferred_ahead(void *ctx, int i)
+{
+    deferred_correction_t *d = ctx;
+    fluid_t *f = d->f;
+    for (; d->next <= i + 1 && d->next <= f->g->nxl - 2; d->next++) {
+        deferred_plane(d, d->next);
+        poisson_fill_ghosts_plane(fluid_priv(f)->pp, f->p, d->next);
+        fluid_apply_bc_plane(f, d->next);
+    }
 }
 
 void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats)
@@ -203,6 +271,13 @@ void fluid_step(fluid_t *f, double dt)
      * unless something changes u* between the sweep and the projection (the
      * immersed-boundary hook, the Crank–Nicolson solves), 3-D only. */
     int is3d = g->dim == 3, impl = f->prm.implicit_viscous, fuse_div = is3d && !impl && !f->stage_hook;
+    /* Deferred correction (theory §1, step 1.5): the correction of stages 1
+     * and 2 done inside the next predictor sweep, when nothing reads u^k in
+     * between (no stage-end hook) and the sweep is the fused one. */
+    int defer = fuse_div && !f->stage_end_hook;
+    deferred_correction_t dc = {.f = f};
+    fluid_ahead_t ahead = {deferred_ahead, &dc};
+    int pending = 0;
     for (int s = 0; s < 3; s++) {
         double adt = (fluid_rk_gamma[s] + fluid_rk_zeta[s]) * dt;
         /* H^k = −∇·(u⊗u) [+ νLu] from u^{k−1} (its ghosts are valid: every
@@ -212,9 +287,11 @@ void fluid_step(fluid_t *f, double dt)
          * u ← u*, h ← H^k, spare ← u^{k−1} (free).  The last stage's H is
          * not needed (ζ_1 = 0: the first stage of the next step does not
          * read H_old), so it is not stored. */
+        if (pending) deferred_start(&dc);
         fluid_rhs_predict_div(f, -1.0, impl ? 0.0 : f->prm.nu, dt * fluid_rk_gamma[s], dt * fluid_rk_zeta[s], adt,
                               impl ? 0.5 * adt * f->prm.nu : 0.0, s < 2 ? q->spare : NULL, q->h, 1.0 / adt,
-                              fuse_div ? q->work : NULL);
+                              fuse_div ? q->work : NULL, pending ? &ahead : NULL);
+        pending = 0;
         for (int c = 0; c < nc; c++) {
             double *old = f->u[c];
             f->u[c] = q->h[c];
@@ -229,7 +306,12 @@ void fluid_step(fluid_t *f, double dt)
             f->stage_hook(f, s, adt, f->hook_ctx);
             fluid_apply_bc(f);
         }
-        project_stage(f, adt, 1, s == 2 ? stats : NULL, fuse_div, s == 2 && is3d ? div_cfl : NULL);
+        if (defer && s < 2) {
+            dc.phi = solve_correction(f, adt, 1);
+            dc.dt_stage = adt;
+            pending = 1;
+        } else
+            project_stage(f, adt, 1, s == 2 ? stats : NULL, fuse_div, s == 2 && is3d ? div_cfl : NULL);
         if (f->stage_end_hook) f->stage_end_hook(f, s, adt, f->hook_ctx);
     }
     f->time += dt;

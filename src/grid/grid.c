@@ -246,10 +246,12 @@ double *field_alloc(const grid_t *g) { return xcalloc((size_t)g->nalloc, sizeof(
 void field_copy(const grid_t *g, double *dst, const double *src) { memcpy(dst, src, (size_t)g->nalloc * sizeof(double)); }
 void field_zero(const grid_t *g, double *f) { memset(f, 0, (size_t)g->nalloc * sizeof(double)); }
 
-void grid_halo_yz(const grid_t *g, double *f)
+void grid_halo_yz(const grid_t *g, double *f) { grid_halo_yz_planes(g, f, -1, g->nxl); }
+
+void grid_halo_yz_planes(const grid_t *g, double *f, int ilo, int ihi)
 {
     int ny = g->n[1], nz = g->n[2];
-    for (int i = -1; i <= g->nxl; i++) {
+    for (int i = ilo; i <= ihi; i++) {
         if (g->dim == 3 && g->periodic[2])
             for (int j = 0; j < ny; j++) {
                 f[G_IDX(g, i, j, -1)] = f[G_IDX(g, i, j, nz - 1)];

@@ -138,16 +138,17 @@ int poisson_is_unknown(const poisson_t *p, int i, int j, int k)
            i < p->g->nxl;
 }
 
-/* Ghost value along a uniform direction for a homogeneous BC.  For a
- * Dirichlet face the boundary value itself (index −1 or n−1) is zero. */
-void poisson_fill_ghosts(const poisson_t *p, double *x)
+/* The y and z boundary ghosts of the x planes ilo..ihi for the homogeneous
+ * BCs (after the periodic copies; for a Dirichlet face the boundary value
+ * itself, index n−1, is zero): each plane's ghosts come from the same plane,
+ * y before z (the z ghosts of the y ghost rows are set last). */
+static void fill_yz_face_ghosts(const poisson_t *p, double *x, int ilo, int ihi)
 {
     const grid_t *g = p->g;
-    int nxl = g->nxl, ny = g->n[1], nz = g->n[2], gz = g->gz;
-    grid_halo(g, x);
+    int ny = g->n[1], nz = g->n[2], gz = g->gz;
     /* y faces */
     if (p->ebc[1][0] != EBC_PERIODIC)
-        for (int i = -1; i <= nxl; i++)
+        for (int i = ilo; i <= ihi; i++)
             for (int k = -gz; k < nz + gz; k++) {
                 double in = x[G_IDX(g, i, 0, k)];
                 ebc_t lo = p->ebc[1][0], hi = p->ebc[1][1];
@@ -162,7 +163,7 @@ void poisson_fill_ghosts(const poisson_t *p, double *x)
             }
     /* z faces */
     if (g->dim == 3 && p->ebc[2][0] != EBC_PERIODIC)
-        for (int i = -1; i <= nxl; i++)
+        for (int i = ilo; i <= ihi; i++)
             for (int j = -1; j <= ny; j++) {
                 double in = x[G_IDX(g, i, j, 0)];
                 ebc_t lo = p->ebc[2][0], hi = p->ebc[2][1];
@@ -175,8 +176,14 @@ void poisson_fill_ghosts(const poisson_t *p, double *x)
                     x[G_IDX(g, i, j, nz)] = hi == EBC_NEUMANN ? inh : -inh;
                 }
             }
-    /* x: boundary folded into the coefficients; zero the boundary value of a
-     * Dirichlet face so that fields stay clean. */
+}
+
+/* x: the boundary is folded into the coefficients; zero the boundary value of
+ * a Dirichlet face so that fields stay clean. */
+static void fill_x_face_values(const poisson_t *p, double *x)
+{
+    const grid_t *g = p->g;
+    int nxl = g->nxl, ny = g->n[1], nz = g->n[2], gz = g->gz;
     if (p->ebc[0][1] == EBC_DIRICHLET_FACE && g->right == MPI_PROC_NULL) {
         for (int j = -1; j <= ny; j++)
             for (int k = -gz; k < nz + gz; k++) x[G_IDX(g, nxl - 1, j, k)] = 0.0;
@@ -185,6 +192,30 @@ void poisson_fill_ghosts(const poisson_t *p, double *x)
         for (int j = -1; j <= ny; j++)
             for (int k = -gz; k < nz + gz; k++) x[G_IDX(g, -1, j, k)] = 0.0;
     }
+}
+
+void poisson_fill_ghosts(const poisson_t *p, double *x)
+{
+    grid_halo(p->g, x);
+    fill_yz_face_ghosts(p, x, -1, p->g->nxl);
+    fill_x_face_values(p, x);
+}
+
+void poisson_fill_ghosts_plane(const poisson_t *p, double *x, int i)
+{
+    grid_halo_yz_planes(p->g, x, i, i);
+    fill_yz_face_ghosts(p, x, i, i);
+}
+
+void poisson_fill_ghosts_edges(const poisson_t *p, double *x)
+{
+    const grid_t *g = p->g;
+    grid_halo_yz_planes(g, x, -1, 0);
+    grid_halo_yz_planes(g, x, g->nxl - 1, g->nxl);
+    grid_halo_x(g, x);
+    fill_yz_face_ghosts(p, x, -1, 0);
+    fill_yz_face_ghosts(p, x, g->nxl - 1, g->nxl);
+    fill_x_face_values(p, x);
 }
 
 void poisson_apply(poisson_t *p, double lambda, double *x, double *y)
