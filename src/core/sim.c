@@ -44,7 +44,7 @@ void sim_register_keys(void) { cfg_schema_add(sim_keys); }
 
 const char *const sim_run_control_keys[] = {"time.t_end",     "time.max_steps", "time.wall_limit", "time.steady_tol",
                                             "time.cfl_abort", "time.ke_growth_abort", "time.rollback",
-                                            "output.*",       NULL};
+                                            "output.*",       "poisson.fftw_wisdom", NULL};
 
 static void read_params(sim_t *s, cfg_t *cfg)
 {

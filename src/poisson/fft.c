@@ -716,7 +716,7 @@ int poisson_fftw_wisdom_check(const char *path, char *why, size_t n)
         int ok = fftw_import_wisdom_from_string(s);
         free(s);
         if (!ok)
-            return snprintf(why, n, "%s is not FFTW wisdom of this FFTW build (%s); delete it to measure again", path,
+            return snprintf(why, n, "%s is not FFTW wisdom of this FFTW build (%s) and planner set; delete it to measure again", path,
                             fftw_version),
                    1;
         return 0;
@@ -783,7 +783,7 @@ static void wisdom_start(const char *path, MPI_Comm comm)
     wis.may_write = 1;
     if (!text) return;
     if (!fftw_import_wisdom_from_string(text))
-        die("poisson.fftw_wisdom: %s is not FFTW wisdom of this FFTW build (%s); delete it to measure again", path,
+        die("poisson.fftw_wisdom: %s is not FFTW wisdom of this FFTW build (%s) and planner set; delete it to measure again", path,
             fftw_version);
     wis.file_len = strlen(text);
     free(text);
