@@ -287,6 +287,8 @@ void sim_add_fluid(sim_t *s, cfg_t *cfg)
     fp->g = grid_create_from_config(cfg, s->comm);
     fluid_params_t prm;
     fluid_params_from_config(cfg, fp->g, &prm);
+    /* ibmdem check writes nothing: the wisdom file was validated, it is not written */
+    if (s->check_only) prm.poisson.fftw_wisdom[0] = 0;
     if (prm.poisson.method == POISSON_FFT && prm.poisson.fftw_measure && s->restart_path[0])
         preset_checkpoint_wisdom(s->restart_path, s->comm);
     fp->f = fluid_create(fp->g, &prm);

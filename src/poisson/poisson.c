@@ -21,9 +21,10 @@ static const cfg_key_t poisson_keys[] = {
      "fft: FFTW planner; measure times candidate algorithms at start-up (10-20 % faster solves); its choices "
      "are kept as FFTW wisdom in the checkpoints and OUT/fftw.wisdom, so restarts are exact, and runs are "
      "bit-identical to each other when they share a wisdom file (fftw_wisdom)"},
-    {"poisson", "fftw_wisdom", CFG_STRING, "", 1, 0, NULL,
+    {"poisson", "fftw_wisdom", CFG_STRING, "none", 1, 0, NULL,
      "fft, measure planner only: FFTW wisdom file read before planning (by rank 0) and written when missing or "
-     "when new transforms were measured; runs given the same file make the same plans (bit-identical results)"},
+     "when new transforms were measured; runs given the same file make the same plans (bit-identical results); "
+     "none: no file"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL}};
 
 void poisson_register_keys(void) { cfg_schema_add(poisson_keys); }
@@ -38,7 +39,7 @@ void poisson_opts_from_config(cfg_t *cfg, poisson_opts_t *o)
     o->fftw_measure = cfg_enum(cfg, "poisson", "fftw_planner") == 1;
     const char *w = cfg_string(cfg, "poisson", "fftw_wisdom");
     o->fftw_wisdom[0] = 0;
-    if (cfg_has(cfg, "poisson", "fftw_wisdom")) {
+    if (strcmp(w, "none") != 0) {
         if (!o->fftw_measure)
             cfg_fail(cfg, "poisson", "fftw_wisdom",
                      "a wisdom file is used by fftw_planner = measure only (estimate plans are the same in every "
