@@ -5,8 +5,14 @@
  * interleaved with the steps and solves (best of each over the repetitions).
  *
  * usage: bench_fluid_step [N=128] [periodic|walls] [fft|multigrid] [explicit|implicit] [steps=5]
- * prints: ns per cell per step, step / transform pair, Poisson solve / pair,
- * peak resident set per cell.
+ *                         [estimate|measure|both]
+ * The FFT solver runs with FFTW_ESTIMATE plans and/or with [poisson]
+ * fftw_planner = measure (default: both, two fluids timed in turn), the
+ * measured plans from the wisdom file named by the environment variable
+ * FFTW_WISDOM (created by the first run, reused after: the plans a run with
+ * that file makes).
+ * prints per planner: ns per cell per step, step / transform pair, Poisson
+ * solve / pair, peak resident set per cell (one fluid), set-up time.
  */
 #include <fftw3-mpi.h>
 #include <math.h>
@@ -83,15 +89,43 @@ static void run_solve(void *a)
     poisson_solve(s->ps, 0.0, s->b, s->x);
 }
 
+/* The fluid of one planner: Taylor–Green initial field (3-D), projected,
+ * one warm-up step (first touches, plan caches); set-up time in *setup. */
+static fluid_t *fluid_of_planner(grid_t *g, fluid_params_t *prm, int measure, double *setup)
+{
+    prm->poisson.fftw_measure = measure;
+    double t0 = wtime();
+    fluid_t *f = fluid_create(g, prm);
+    *setup = wtime() - t0;
+    int N = g->n[1];
+    for (int i = 0; i < g->nxl; i++)
+        for (int j = 0; j < N; j++)
+            for (int k = 0; k < N; k++) {
+                long c = G_IDX(g, i, j, k);
+                double xf = g->xf[i], xc = g->xc[i], yf = grid_yf(g, j), yc = grid_yc(g, j), zc = grid_zc(g, k);
+                f->u[0][c] = sin(xf) * cos(yc) * cos(zc);
+                f->u[1][c] = -cos(xc) * sin(yf) * cos(zc);
+                f->u[2][c] = 0.0;
+            }
+    fluid_project(f);
+    fluid_step(f, prm->dt_fixed);
+    return f;
+}
+
 int main(int argc, char **argv)
 {
     MPI_Init(&argc, &argv);
-    fftw_mpi_init();
     int N = argc > 1 ? atoi(argv[1]) : 128;
     int walls = argc > 2 && !strcmp(argv[2], "walls");
     int mg = argc > 3 && !strcmp(argv[3], "multigrid");
     int implicit = argc > 4 && !strcmp(argv[4], "implicit");
     int nsteps = argc > 5 ? atoi(argv[5]) : 5;
+    const char *planner = argc > 6 ? argv[6] : "both";
+    /* the planners timed: estimate (variant 0) and/or measure (variant 1);
+     * multigrid plans nothing */
+    int use[2] = {mg || strcmp(planner, "measure") != 0, !mg && strcmp(planner, "estimate") != 0};
+    /* the measuring planner's wisdom file (FFTW_WISDOM): measured once, reused */
+    const char *wisdom = getenv("FFTW_WISDOM");
 
     int n[3] = {N, N, N};
     double L[3] = {2 * M_PI, 2 * M_PI, 2 * M_PI};
@@ -113,61 +147,80 @@ int main(int argc, char **argv)
     prm.poisson.mg_tol = 1e-8;
     prm.poisson.mg_max_cycles = 50;
     prm.poisson.mg_pre = prm.poisson.mg_post = 2;
-    fluid_t *f = fluid_create(g, &prm);
-    /* Taylor–Green initial field (3-D) */
-    for (int i = 0; i < g->nxl; i++)
-        for (int j = 0; j < N; j++)
-            for (int k = 0; k < N; k++) {
-                long c = G_IDX(g, i, j, k);
-                double xf = g->xf[i], xc = g->xc[i], yf = grid_yf(g, j), yc = grid_yc(g, j), zc = grid_zc(g, k);
-                f->u[0][c] = sin(xf) * cos(yc) * cos(zc);
-                f->u[1][c] = -cos(xc) * sin(yf) * cos(zc);
-                f->u[2][c] = 0.0;
-            }
-    fluid_project(f);
-    fluid_step(f, prm.dt_fixed); /* warm-up: first touches, plan caches */
-    /* the solver's memory: before the benchmark's own solver and transform */
-    long rss = peak_rss_bytes(), rss_max;
-    /* the Poisson solve alone, on the same grid */
-    poisson_t *ps = poisson_create(g, VAR_P, &prm.poisson);
+    if (wisdom) snprintf(prm.poisson.fftw_wisdom, sizeof prm.poisson.fftw_wisdom, "%s", wisdom);
+    fluid_t *f[2] = {NULL, NULL};
+    poisson_t *ps[2] = {NULL, NULL};
+    double setup[2] = {0, 0};
+    long rss = -1, rss_max;
     double *b = field_alloc(g), *x = field_alloc(g);
     for (int i = 0; i < g->nxl; i++)
         for (int j = 0; j < N; j++)
             for (int k = 0; k < N; k++)
                 b[G_IDX(g, i, j, k)] = cos(g->xc[i]) * cos(2 * grid_yc(g, j)) * cos(3 * grid_zc(g, k));
-    poisson_solve(ps, 0.0, b, x);
+    for (int v = 0; v < 2; v++) {
+        if (!use[v]) continue;
+        f[v] = fluid_of_planner(g, &prm, v, &setup[v]);
+        /* the solver's memory: one fluid, before the benchmark's own solvers and transform */
+        if (rss < 0) rss = peak_rss_bytes();
+        /* the Poisson solve alone, on the same grid (its plans come from the
+         * wisdom the fluid's set-up left) */
+        ps[v] = poisson_create(g, VAR_P, &prm.poisson);
+        poisson_solve(ps[v], 0.0, b, x);
+    }
+    /* FFTW-MPI registers its planners only now: they change the signature
+     * of the wisdom, and the solvers' wisdom file must stay the one of
+     * ibmdem (which does not use FFTW-MPI) */
+    fftw_mpi_init();
     fft_pair_t fp;
     fft_pair_create(&fp, N);
     fft_pair_run(&fp);
-    /* step, solve and transform pair interleaved, best of nsteps each */
-    tmin_t tstep = {1e30, 1e30}, tsolve = {1e30, 1e30}, tpair = {1e30, 1e30};
-    step_arg_t sa = {f, prm.dt_fixed};
-    solve_arg_t so = {ps, b, x};
+    /* transform pair, then each planner's step and solve, interleaved; best of nsteps each */
+    tmin_t tstep[2], tsolve[2], tpair = {1e30, 1e30};
+    step_arg_t sa[2];
+    solve_arg_t so[2];
+    for (int v = 0; v < 2; v++) {
+        tstep[v] = tsolve[v] = (tmin_t){1e30, 1e30};
+        sa[v] = (step_arg_t){f[v], prm.dt_fixed};
+        so[v] = (solve_arg_t){ps[v], b, x};
+    }
     for (int s = 0; s < nsteps; s++) {
         timed(&tpair, run_pair, &fp);
-        timed(&tstep, run_step, &sa);
-        timed(&tsolve, run_solve, &so);
+        for (int v = 0; v < 2; v++)
+            if (use[v]) timed(&tstep[v], run_step, &sa[v]);
+        for (int v = 0; v < 2; v++)
+            if (use[v]) timed(&tsolve[v], run_solve, &so[v]);
     }
-    double best = tstep.wall, best_p = tsolve.wall, pair = tpair.wall;
-    int mg_cycles = ps->last_iterations;
     MPI_Allreduce(&rss, &rss_max, 1, MPI_LONG, MPI_MAX, MPI_COMM_WORLD);
-    double bytes_per_cell = (double)rss_max / (double)g->ncell_local;
+    double bytes_per_cell = (double)rss_max / (double)g->ncell_local, pair = tpair.wall;
+    double cells = (double)N * N * N;
+    const char *pname[2] = {"estimate", "measure"};
+    for (int v = 0; v < 2; v++) {
+        if (!use[v]) continue;
+        double best = tstep[v].wall, best_p = tsolve[v].wall;
+        msg("bench_fluid_step N=%d %s %s %s ranks=%d%s%s: step %.4f s = %.1f ns/cell | poisson %.4f s%s | fftw "
+            "r2c+c2r pair %.4f s | step/pair %.2f | poisson/pair %.2f | peak RSS %.0f B/cell\n",
+            N, walls ? "walls" : "periodic", mg ? "multigrid" : "fft", implicit ? "implicit" : "explicit", g->nranks,
+            mg ? "" : " planner=", mg ? "" : pname[v], best, best / cells * 1e9, best_p,
+            mg ? " (multigrid cycles shown below)" : "", pair, best / pair, best_p / pair, bytes_per_cell);
+        /* the same ratios in CPU time (max over ranks): insensitive to time
+         * slices lost to other processes, not to memory-bandwidth contention */
+        msg("bench_fluid_step   cpu time%s%s: step %.4f s | poisson %.4f s | pair %.4f s | step/pair %.2f | "
+            "poisson/pair %.2f\n",
+            mg ? "" : ", ", mg ? "" : pname[v], tstep[v].cpu, tsolve[v].cpu, tpair.cpu, tstep[v].cpu / tpair.cpu,
+            tsolve[v].cpu / tpair.cpu);
+        if (!mg)
+            msg("bench_fluid_step   set-up (fluid_create, plans of the pressure%s solver) %s: %.2f s%s\n",
+                implicit ? " and Helmholtz" : "", pname[v], setup[v],
+                v == 1 ? (wisdom ? " (wisdom file FFTW_WISDOM)" : " (no wisdom file)") : "");
+    }
+    if (mg) msg("  multigrid V-cycles per solve to 1e-8: %d\n", ps[0]->last_iterations);
     free(b);
     free(x);
-    poisson_free(ps);
     fft_pair_free(&fp);
-    double cells = (double)N * N * N;
-    msg("bench_fluid_step N=%d %s %s %s ranks=%d: step %.4f s = %.1f ns/cell | poisson %.4f s%s | fftw r2c+c2r pair "
-        "%.4f s | step/pair %.2f | poisson/pair %.2f | peak RSS %.0f B/cell\n",
-        N, walls ? "walls" : "periodic", mg ? "multigrid" : "fft", implicit ? "implicit" : "explicit", g->nranks, best,
-        best / cells * 1e9, best_p, mg ? " (multigrid cycles shown below)" : "", pair, best / pair,
-        best_p / pair, bytes_per_cell);
-    /* the same ratios in CPU time (max over ranks): insensitive to time slices
-     * lost to other processes, not to memory-bandwidth contention */
-    msg("bench_fluid_step   cpu time: step %.4f s | poisson %.4f s | pair %.4f s | step/pair %.2f | poisson/pair %.2f\n", tstep.cpu,
-        tsolve.cpu, tpair.cpu, tstep.cpu / tpair.cpu, tsolve.cpu / tpair.cpu);
-    if (mg) msg("  multigrid V-cycles per solve to 1e-8: %d\n", mg_cycles);
-    fluid_free(f);
+    for (int v = 0; v < 2; v++) {
+        poisson_free(ps[v]);
+        if (f[v]) fluid_free(f[v]);
+    }
     grid_free(g);
     fftw_mpi_cleanup();
     MPI_Finalize();

@@ -13,9 +13,12 @@
  * planned with FFTW_ESTIMATE (as the solver) and with FFTW_MEASURE (the
  * best FFTW can do); ratios are given to both.  With P ranks the solve is
  * distributed and its ratio to the serial pair includes the parallel
- * speed-up.  Peak RSS is per rank, before the reference transforms run.
+ * speed-up.  Peak RSS is per rank, after the first solver (periodic,
+ * estimate) was set up and ran once.
  * The solves run with the default planner (FFTW_ESTIMATE, bit-reproducible)
- * and with [poisson] fftw_planner = measure.
+ * and with [poisson] fftw_planner = measure (plans from the wisdom file named
+ * by the environment variable FFTW_WISDOM when set: created by the first
+ * run, reused after), the four solvers timed in turn in each repetition.
  */
 #include <fftw3.h>
 #include <math.h>
@@ -71,40 +74,60 @@ static times_t best_pair_time(int n, unsigned flags, int reps)
     return best;
 }
 
-static times_t best_solve_time(int n, bc_type_t wall, int measure, int reps)
+/* One solver of the benchmark: its grid, planner, right-hand side. */
+typedef struct {
+    grid_t *g;
+    poisson_t *p;
+    double *b, *x;
+    int measure;
+    double setup; /* seconds of poisson_create (planning) */
+    times_t best;
+} solver_t;
+
+static void solver_create(solver_t *s, int n, bc_type_t wall, int measure, const char *wisdom)
 {
     int nn[3] = {n, n, n};
     double L[3] = {1, 1, 1};
     bc_t bc;
     memset(&bc, 0, sizeof bc);
     for (int d = 0; d < 3; d++) bc.type[d][0] = bc.type[d][1] = wall;
-    grid_t *g = grid_create(GEOM_3D, nn, L, NULL, &bc, STRETCH_UNIFORM, 0, MPI_COMM_WORLD);
+    s->g = grid_create(GEOM_3D, nn, L, NULL, &bc, STRETCH_UNIFORM, 0, MPI_COMM_WORLD);
     poisson_opts_t o = {.method = POISSON_FFT, .fftw_measure = measure};
+    if (measure && wisdom) snprintf(o.fftw_wisdom, sizeof o.fftw_wisdom, "%s", wisdom);
+    s->measure = measure;
+    MPI_Barrier(s->g->comm);
     double tp = wtime();
-    poisson_t *p = poisson_create(g, VAR_P, &o);
-    tp = wtime() - tp;
-    double *b = field_alloc(g), *x = field_alloc(g);
+    s->p = poisson_create(s->g, VAR_P, &o);
+    s->setup = wtime() - tp;
+    const grid_t *g = s->g;
+    s->b = field_alloc(g);
+    s->x = field_alloc(g);
     for (int i = 0; i < g->nxl; i++)
         for (int j = 0; j < n; j++)
             for (int k = 0; k < n; k++)
-                b[G_IDX(g, i, j, k)] = sin(2 * M_PI * g->xc[i]) * cos(2 * M_PI * grid_yc(g, j)) *
-                                           cos(4 * M_PI * grid_zc(g, k)) +
-                                       0.1 * sin(0.37 * (i + g->ix0 + 3 * j + 7 * k));
-    times_t best = {1e30, 1e30};
-    for (int it = 0; it < reps; it++) {
-        MPI_Barrier(g->comm);
-        double w0 = wtime(), c0 = cpu_time();
-        poisson_solve(p, 0.0, b, x);
-        keep_best(&best, w0, c0, g->comm);
-    }
-    double res = poisson_residual(p, 0.0, b, x);
-    msg("  %s, %s planner: relative residual %.2e, set-up %.2f s\n", wall == BC_PERIODIC ? "periodic" : "walls",
-        measure ? "measure" : "estimate", res, tp);
-    free(b);
-    free(x);
-    poisson_free(p);
-    grid_free(g);
-    return best;
+                s->b[G_IDX(g, i, j, k)] = sin(2 * M_PI * g->xc[i]) * cos(2 * M_PI * grid_yc(g, j)) *
+                                              cos(4 * M_PI * grid_zc(g, k)) +
+                                          0.1 * sin(0.37 * (i + g->ix0 + 3 * j + 7 * k));
+    s->best = (times_t){1e30, 1e30};
+    poisson_solve(s->p, 0.0, s->b, s->x); /* first touches */
+}
+
+static void solver_time(solver_t *s)
+{
+    MPI_Barrier(s->g->comm);
+    double w0 = wtime(), c0 = cpu_time();
+    poisson_solve(s->p, 0.0, s->b, s->x);
+    keep_best(&s->best, w0, c0, s->g->comm);
+}
+
+static void solver_free(solver_t *s, const char *name)
+{
+    double res = poisson_residual(s->p, 0.0, s->b, s->x);
+    msg("  %s: relative residual %.2e, set-up (planning) %.2f s\n", name, res, s->setup);
+    free(s->b);
+    free(s->x);
+    poisson_free(s->p);
+    grid_free(s->g);
 }
 
 int main(int argc, char **argv)
@@ -120,10 +143,24 @@ int main(int argc, char **argv)
     msg("bench_poisson: %d^3 cells, %d rank(s), best of %d (wall / cpu seconds)\n", n, P, reps);
     const char *names[4] = {"periodic", "walls", "periodic, measure planner", "walls, measure planner"};
     bc_type_t walls[2] = {BC_PERIODIC, BC_NOSLIP};
+    /* the measuring planner's wisdom file (FFTW_WISDOM): measured once, reused */
+    const char *wisdom = getenv("FFTW_WISDOM");
+    solver_t sv[4];
     times_t t[4];
-    for (int c = 0; c < 4; c++) t[c] = best_solve_time(n, walls[c % 2], c / 2, reps);
-    /* peak memory of the solves (before the reference transforms allocate) */
-    double rss = (double)peak_rss_bytes(), rmax;
+    double rss = 0, rmax;
+    for (int c = 0; c < 4; c++) {
+        solver_create(&sv[c], n, walls[c % 2], c / 2, wisdom);
+        /* peak memory of one solver and its fields (the first: periodic, estimate) */
+        if (c == 0) rss = (double)peak_rss_bytes();
+    }
+    /* the four solvers in turn, so that each sees the same machine state */
+    for (int it = 0; it < reps; it++)
+        for (int c = 0; c < 4; c++) solver_time(&sv[c]);
+    for (int c = 0; c < 4; c++) {
+        t[c] = sv[c].best;
+        solver_free(&sv[c], names[c]);
+    }
+    if (wisdom) msg("  measure planner: wisdom file %s (FFTW_WISDOM)\n", wisdom);
     MPI_Allreduce(&rss, &rmax, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
     times_t pe = {0, 0}, pm = {0, 0};
     if (mpi_rank() == 0) {
@@ -149,7 +186,7 @@ int main(int argc, char **argv)
             names[c], t[c].wall, t[c].cpu, 1e9 * t[c].wall / cells, t[c].wall / pe.wall, t[c].cpu / pe.cpu,
             t[c].wall / pm.wall, t[c].cpu / pm.cpu);
     }
-    msg("  peak RSS of the solves (max over ranks) %.1f MB = %.0f bytes per local cell\n", rmax / 1048576.0,
+    msg("  peak RSS of one solver with its fields (max over ranks) %.1f MB = %.0f bytes per local cell\n", rmax / 1048576.0,
         rmax / (cells / P));
     const char *keys[4] = {"periodic", "walls", "periodic_measure", "walls_measure"};
     for (int c = 0; c < 4; c++)

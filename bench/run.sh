@@ -7,6 +7,7 @@
 #   ONLY=regex   run only the sections whose name matches (fluid, poisson,
 #                multigrid, porenet, dem, ibm)
 #   N=64         grid size of the fluid/Poisson benches (default 128)
+#   FFTW_WISDOM  wisdom file of the measuring planner (default $BUILD/bench_results/fftw.wisdom)
 #   Builds nothing (`make bench` builds first).
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-build}
@@ -16,6 +17,9 @@ MPIRUN="mpirun --allow-run-as-root --oversubscribe"
 OUT=$BUILD/bench_results
 mkdir -p "$OUT"
 RES=$OUT/results.txt
+# the measuring FFTW planner's wisdom (bench_fluid_step, bench_poisson time both
+# planners): measured by the first run that needs a transform, reused after
+export FFTW_WISDOM=${FFTW_WISDOM:-$PWD/$OUT/fftw.wisdom}
 : >"$RES"
 status=0
 

@@ -38,7 +38,8 @@ typedef struct {
     double mg_tol;     /* multigrid: relative residual tolerance */
     int mg_max_cycles; /* multigrid: maximum V-cycles */
     int mg_pre, mg_post; /* multigrid: smoothing sweeps */
-    int fftw_measure;    /* fft: plan with FFTW_MEASURE (faster, not bit-reproducible run to run) */
+    int fftw_measure;    /* fft: plan with FFTW_MEASURE, reproducibly through FFTW wisdom (fft.c) */
+    char fftw_wisdom[4096]; /* fft, measure: wisdom file read before planning, written when it grows ("" none) */
 } poisson_opts_t;
 
 typedef struct poisson poisson_t;
@@ -127,6 +128,17 @@ void poisson_add_constant(const poisson_t *p, double *f, double c);
 /* Relative residual ||b − (L − λI)x||₂ / ||b||₂ over the unknowns (uses a
  * scratch field; for tests and diagnostics). */
 double poisson_residual(poisson_t *p, double lambda, const double *b, double *x);
+
+/* FFTW wisdom of the measuring planner (fft back-end, fftw_planner = measure;
+ * see fft.c).  preset: wisdom imported instead of the file before the next
+ * measured set-up (a restart passes the checkpoint's copy; NULL clears).
+ * used: the wisdom the measured plans were made from, the same on every rank
+ * (NULL before any measured set-up); the checkpoints store it.  check: 0 if
+ * path is usable (an existing file holds wisdom of this FFTW build, or the
+ * folder of a missing one is writable), else 1 with the reason in why. */
+void poisson_fftw_wisdom_preset(const char *wisdom);
+const char *poisson_fftw_wisdom_used(void);
+int poisson_fftw_wisdom_check(const char *path, char *why, size_t n);
 
 /* Back-ends */
 extern const poisson_backend_t poisson_backend_fft;

@@ -139,7 +139,8 @@ int sim_run(sim_t *s);
 void sim_free(sim_t *s);
 
 /* The keys a restart may change without breaking exactness (the fingerprint
- * skips them): run control and outputs. */
+ * skips them): run control, outputs, and the FFTW wisdom file (a restart
+ * plans from the checkpoint's copy of the wisdom). */
 extern const char *const sim_run_control_keys[];
 
 /* Add cell fields to the fluid's snapshots (see sim_field_writer_t). */

@@ -2,6 +2,7 @@
  * the divergence checks and the schedule of the outputs.  The physics lives
  * in the parts (sim_fluid.c, ...). */
 #include "coupling.h"
+#include "poisson.h"
 #include "sim.h"
 
 #include <inttypes.h>
@@ -43,7 +44,7 @@ void sim_register_keys(void) { cfg_schema_add(sim_keys); }
 
 const char *const sim_run_control_keys[] = {"time.t_end",     "time.max_steps", "time.wall_limit", "time.steady_tol",
                                             "time.cfl_abort", "time.ke_growth_abort", "time.rollback",
-                                            "output.*",       NULL};
+                                            "output.*",       "poisson.fftw_wisdom", NULL};
 
 static void read_params(sim_t *s, cfg_t *cfg)
 {
@@ -145,6 +146,20 @@ static void read_checkpoint(sim_t *s, const char *path)
     msg("restarted from %s at step %ld, t = %.10g\n", path, s->step, s->time);
 }
 
+/* The FFTW wisdom the measuring planner made its plans from, as
+ * DIR/fftw.wisdom: `--set poisson.fftw_wisdom=DIR/fftw.wisdom` makes the
+ * same plans in another run (bit-identical results). */
+static void write_fftw_wisdom(const sim_t *s)
+{
+    const char *w = poisson_fftw_wisdom_used();
+    if (!w || mpi_rank() != 0) return;
+    char path[IO_PATH_MAX + 16];
+    io_outdir_path(&s->out, "fftw.wisdom", path, sizeof path);
+    FILE *f = fopen(path, "wb");
+    size_t n = strlen(w);
+    if (!f || fwrite(w, 1, n, f) != n || fclose(f) != 0) die_local("cannot write %s", path);
+}
+
 /* ---- setup ----------------------------------------------------------------- */
 
 sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
@@ -154,6 +169,9 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
     s->comm = MPI_COMM_WORLD;
     s->check_only = check_only;
     read_params(s, cfg);
+    /* known to the parts as they are built (the fluid's planner imports the
+     * checkpoint's FFTW wisdom before it plans) */
+    if (restart) snprintf(s->restart_path, sizeof s->restart_path, "%s", restart);
 
     /* Parts of the scene, in the order they advance. */
     if (sim_fluid_enabled(cfg)) sim_add_fluid(s, cfg);
@@ -196,10 +214,8 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
     io_outdir_write_input(&s->out, cfg);
     msg("ibmdem %s: case %s (%s) on %d rank%s, output in %s\n", IBMDEM_VERSION, s->prm.name, cfg_path(cfg),
         mpi_size(), mpi_size() > 1 ? "s" : "", s->prm.dir);
-    if (restart) {
-        snprintf(s->restart_path, sizeof s->restart_path, "%s", restart);
-        read_checkpoint(s, restart);
-    }
+    write_fftw_wisdom(s);
+    if (restart) read_checkpoint(s, restart);
     s->step0 = s->step;
 
     /* Time series: step, time, dt, the parts' columns, wall time per step. */

@@ -170,6 +170,33 @@ static void part_checkpoint_write(void *ctx, hid_t grp)
         if (c == 2 && fp->g->dim != 3) continue;
         io_h5_write_field(grp, field_name[c], fp->g, src);
     }
+    /* the measuring planner's choices: a restart makes the same plans */
+    const char *w = poisson_fftw_wisdom_used();
+    if (f->prm.poisson.fftw_measure && w) io_h5_write_text(grp, "fftw_wisdom", w);
+}
+
+/* Restart with the measuring planner: plan from the FFTW wisdom the
+ * checkpoint's run used (/fluid/fftw_wisdom), so that the plans, hence the
+ * round-off, are those of the uninterrupted run, whatever the wisdom file
+ * holds now. */
+static void preset_checkpoint_wisdom(const char *path, MPI_Comm comm)
+{
+    io_checkpoint_header_t h;
+    hid_t f = io_checkpoint_open(path, &h, comm);
+    char *w = NULL;
+    if (H5Lexists(f, "fluid", H5P_DEFAULT) > 0) {
+        hid_t g = H5Gopen2(f, "fluid", H5P_DEFAULT);
+        w = io_h5_read_text(g, "fftw_wisdom");
+        H5Gclose(g);
+    }
+    io_checkpoint_header_free(&h);
+    io_h5_close(f);
+    if (!w)
+        warn("%s holds no FFTW wisdom (written with fftw_planner = estimate, or without a fluid): the plans are "
+             "measured again, so the continuation agrees to round-off, not bit for bit\n",
+             path);
+    poisson_fftw_wisdom_preset(w);
+    free(w);
 }
 
 /* Ghosts of the pressure after a restart: halo exchange, and at a
@@ -260,6 +287,10 @@ void sim_add_fluid(sim_t *s, cfg_t *cfg)
     fp->g = grid_create_from_config(cfg, s->comm);
     fluid_params_t prm;
     fluid_params_from_config(cfg, fp->g, &prm);
+    /* ibmdem check writes nothing: the wisdom file was validated, it is not written */
+    if (s->check_only) prm.poisson.fftw_wisdom[0] = 0;
+    if (prm.poisson.method == POISSON_FFT && prm.poisson.fftw_measure && s->restart_path[0])
+        preset_checkpoint_wisdom(s->restart_path, s->comm);
     fp->f = fluid_create(fp->g, &prm);
     fluid_init_from_config(fp->f, cfg);
     fluid_apply_bc(fp->f);
