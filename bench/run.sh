@@ -35,8 +35,8 @@ run() {
 
 if want fluid; then
     for np in 1 2; do
-        run fluid_periodic_np$np $MPIRUN -np $np "$BUILD/bench/bench_fluid_step" "$N" periodic fft explicit 5
-        run fluid_walls_np$np $MPIRUN -np $np "$BUILD/bench/bench_fluid_step" "$N" walls fft explicit 5
+        run fluid_periodic_np$np $MPIRUN -np $np "$BUILD/bench/bench_fluid_step" "$N" periodic fft explicit 10
+        run fluid_walls_np$np $MPIRUN -np $np "$BUILD/bench/bench_fluid_step" "$N" walls fft explicit 10
         run fluid_walls_mg_np$np $MPIRUN -np $np "$BUILD/bench/bench_fluid_step" "$N" walls multigrid explicit 3
     done
 fi
