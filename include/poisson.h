@@ -100,6 +100,16 @@ void poisson_free(poisson_t *p);
  * Returns 0, or −1 if an iterative method did not converge. */
 int poisson_solve(poisson_t *p, double lambda, const double *b, double *x);
 
+/* The solve in two parts, for a caller that reads x plane by plane
+ * (available when poisson_solve_by_planes: the FFT solver on one rank with
+ * the reordered cosine transforms): poisson_solve_begin(p, λ, b) does all
+ * but writing x; poisson_solve_plane(p, x, i) then writes the unknowns of x
+ * plane i (every plane once, before the next solve).  Bit-identical to
+ * poisson_solve; the ghosts of x are not touched. */
+int poisson_solve_by_planes(const poisson_t *p);
+void poisson_solve_begin(poisson_t *p, double lambda, const double *b);
+void poisson_solve_plane(poisson_t *p, double *x, int i);
+
 /* y = (L − λI) x on the interior unknowns.  Fills the ghosts of x first
  * (halo exchange + homogeneous BC), so x is modified in its ghosts only. */
 void poisson_apply(poisson_t *p, double lambda, double *x, double *y);

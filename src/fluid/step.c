@@ -177,10 +177,25 @@ static void project_stage(fluid_t *f, double dt_stage, int update_pressure, doub
  * reads φ at i' and i' + 1). */
 typedef struct {
     fluid_t *f;
-    const double *phi;
+    double *phi;
     double dt_stage;
-    int next; /* first inner plane not yet corrected */
+    int next;      /* first inner plane not yet corrected */
+    int by_planes; /* φ itself written plane by plane (poisson_solve_plane), just ahead of its use */
+    int phi_next;  /* first inner plane of φ not yet written */
 } deferred_correction_t;
+
+/* φ written on the inner planes up to n (by_planes), with their ghosts: the
+ * correction of plane n reads φ on planes n and n + 1. */
+static void deferred_phi(deferred_correction_t *d, int n)
+{
+    fluid_t *f = d->f;
+    const poisson_t *pp = fluid_priv(f)->pp;
+    if (n > f->g->nxl - 2) n = f->g->nxl - 2;
+    for (; d->phi_next <= n; d->phi_next++) {
+        poisson_solve_plane(fluid_priv(f)->pp, d->phi, d->phi_next);
+        poisson_fill_ghosts_plane(pp, d->phi, d->phi_next);
+    }
+}
 
 static void deferred_plane(deferred_correction_t *d, int i)
 {
@@ -192,6 +207,16 @@ static void deferred_start(deferred_correction_t *d)
 {
     fluid_t *f = d->f;
     int nxl = f->g->nxl;
+    if (d->by_planes) {
+        /* φ on the edge planes (and their ghosts, the x halo), then on plane 1,
+         * which the correction of plane 0 reads */
+        poisson_t *pp = fluid_priv(f)->pp;
+        poisson_solve_plane(pp, d->phi, 0);
+        if (nxl > 1) poisson_solve_plane(pp, d->phi, nxl - 1);
+        poisson_fill_ghosts_edges(pp, d->phi);
+        d->phi_next = 1;
+        deferred_phi(d, 1);
+    }
     deferred_plane(d, 0);
     if (nxl > 1) deferred_plane(d, nxl - 1);
     poisson_fill_ghosts_edges(fluid_priv(f)->pp, f->p);
@@ -205,6 +230,7 @@ static void deferred_ahead(void *ctx, int i)
     deferred_correction_t *d = ctx;
     fluid_t *f = d->f;
     for (; d->next <= i + 1 && d->next <= f->g->nxl - 2; d->next++) {
+        if (d->by_planes) deferred_phi(d, d->next + 1);
         deferred_plane(d, d->next);
         poisson_fill_ghosts_plane(fluid_priv(f)->pp, f->p, d->next);
         fluid_apply_bc_plane(f, d->next);
@@ -307,7 +333,15 @@ void fluid_step(fluid_t *f, double dt)
             fluid_apply_bc(f);
         }
         if (defer && s < 2) {
-            dc.phi = solve_correction(f, adt, 1);
+            dc.by_planes = poisson_solve_by_planes(q->pp);
+            if (dc.by_planes) {
+                /* φ itself is written plane by plane inside the next sweep */
+                poisson_solve_begin(q->pp, 0.0, q->work);
+                f->diag.res_poisson = q->pp->last_residual;
+                f->diag.it_poisson = q->pp->last_iterations;
+                dc.phi = q->work;
+            } else
+                dc.phi = solve_correction(f, adt, 1);
             dc.dt_stage = adt;
             pending = 1;
         } else

@@ -341,12 +341,12 @@ static void setup_steps(fft_t *t)
  * which stays in cache, then one 2-D r2c into the work plane.  Inverse: c2r
  * of the work plane into pbuf, scattered back.  This costs no extra pass
  * over memory compared with a transform from the field. */
-static void plane_transforms(fft_t *t, double *f, int inverse)
+static void plane_transform(fft_t *t, double *f, int inverse, int i)
 {
     const grid_t *g = t->p->g;
     int ny = t->ny, nz = t->nz, hz = nz / 2;
     long o = G_IDX(g, 0, 0, 0);
-    for (int i = 0; i < t->nxu; i++) {
+    {
         fftw_complex *w = (fftw_complex *)(t->work + i * t->PS);
         if (inverse) fftw_execute_dft_c2r(t->pinv, w, t->pbuf);
         for (int n1 = 0; n1 < ny; n1++) {
@@ -369,6 +369,13 @@ static void plane_transforms(fft_t *t, double *f, int inverse)
         if (!inverse) fftw_execute_dft_r2c(t->pfwd, t->pbuf, w);
     }
 }
+
+static void plane_transforms(fft_t *t, double *f, int inverse)
+{
+    for (int i = 0; i < t->nxu; i++) plane_transform(t, f, inverse, i);
+}
+
+static void plane_inverse(fft_t *t, double *f, int i) { plane_transform(t, f, 1, i); }
 
 static void plane_plans(fft_t *t)
 {
@@ -1346,6 +1353,43 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
     p->last_iterations = 1;
     p->last_residual = -1.0; /* not measured (see poisson.h) */
     return 0;
+}
+
+/* ---- the solve in two parts ------------------------------------------------
+ *
+ * On one rank with the reordered transforms (every box with Neumann y or z
+ * pairs: walls), the inverse transforms write x one plane at a time
+ * (plane_transforms), so a caller that reads x plane by plane — the deferred
+ * correction of the fluid step — can have each plane written just before it
+ * reads it, while it is in cache, instead of in a pass of its own.
+ * poisson_solve_begin does all of fft_solve up to the inverse transforms;
+ * poisson_solve_plane(i) is the inverse transform of plane i, the same
+ * operations as in plane_transforms, so the result is bit-identical. */
+static int fft_by_planes(const poisson_t *p)
+{
+    const fft_t *t = p->impl;
+    const grid_t *g = p->g;
+    return p->backend == &poisson_backend_fft && t && t->reord && t->P == 1 && t->nsteps == 0 && t->nxu == g->nxl &&
+           t->ny == g->n[1] && t->nz == g->n[2];
+}
+
+int poisson_solve_by_planes(const poisson_t *p) { return fft_by_planes(p); }
+
+void poisson_solve_begin(poisson_t *p, double lambda, const double *b)
+{
+    if (!fft_by_planes(p)) die("poisson_solve_begin: not available for this solver");
+    fft_t *t = p->impl;
+    scratch_attach(t);
+    if (t->nxu > 0) plane_transforms(t, (double *)b + G_IDX(p->g, 0, 0, 0), 0);
+    tridiagonal_solves(t, lambda);
+    p->last_iterations = 1;
+    p->last_residual = -1.0;
+}
+
+void poisson_solve_plane(poisson_t *p, double *x, int i)
+{
+    fft_t *t = p->impl;
+    plane_inverse(t, x + G_IDX(p->g, 0, 0, 0), i);
 }
 
 static void fft_destroy(void *impl)
