@@ -107,17 +107,21 @@ static void correct_velocity(fluid_t *f, const double *restrict ph, double dt_st
  * and completed after the ghost fill. */
 /* The pressure correction φ of a stage into q->work, ghosts filled:
  * L φ = D(u*)/(αΔt), solved in place (div_ready: q->work already holds the
- * right-hand side). */
-static double *solve_correction(fluid_t *f, double dt_stage, int div_ready)
+ * right-hand side).  With `by_planes` the solve stops before writing φ,
+ * which the deferred correction then writes plane by plane
+ * (poisson_solve_plane; ghosts filled there). */
+static double *solve_correction(fluid_t *f, double dt_stage, int div_ready, int by_planes)
 {
     fluid_priv_t *q = fluid_priv(f);
     double *phi = q->work;
     if (!div_ready) fluid_divergence_scaled(f, 1.0 / dt_stage, phi);
-    if (poisson_solve(q->pp, 0.0, phi, phi) != 0)
+    if (by_planes)
+        poisson_solve_begin(q->pp, 0.0, phi);
+    else if (poisson_solve(q->pp, 0.0, phi, phi) != 0)
         warn("step %ld: the pressure solve did not converge (residual %.3e)\n", f->step, q->pp->last_residual);
     f->diag.res_poisson = q->pp->last_residual;
     f->diag.it_poisson = q->pp->last_iterations;
-    fluid_fill_pressure_ghosts(f, phi);
+    if (!by_planes) fluid_fill_pressure_ghosts(f, phi);
     return phi;
 }
 
@@ -126,7 +130,7 @@ static void project_stage(fluid_t *f, double dt_stage, int update_pressure, doub
 {
     const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
-    double *phi = solve_correction(f, dt_stage, div_ready);
+    double *phi = solve_correction(f, dt_stage, div_ready, 0);
     /* u −= α Δt G φ [and p += φ with explicit viscous terms], one sweep */
     int fuse_p = update_pressure && !f->prm.implicit_viscous;
     correct_velocity(f, phi, dt_stage, fuse_p, stats, div_cfl);
@@ -189,10 +193,10 @@ typedef struct {
 static void deferred_phi(deferred_correction_t *d, int n)
 {
     fluid_t *f = d->f;
-    const poisson_t *pp = fluid_priv(f)->pp;
+    poisson_t *pp = fluid_priv(f)->pp;
     if (n > f->g->nxl - 2) n = f->g->nxl - 2;
     for (; d->phi_next <= n; d->phi_next++) {
-        poisson_solve_plane(fluid_priv(f)->pp, d->phi, d->phi_next);
+        poisson_solve_plane(pp, d->phi, d->phi_next);
         poisson_fill_ghosts_plane(pp, d->phi, d->phi_next);
     }
 }
@@ -333,15 +337,9 @@ void fluid_step(fluid_t *f, double dt)
             fluid_apply_bc(f);
         }
         if (defer && s < 2) {
+            /* where the solver allows it, φ itself is written plane by plane inside the next sweep */
             dc.by_planes = poisson_solve_by_planes(q->pp);
-            if (dc.by_planes) {
-                /* φ itself is written plane by plane inside the next sweep */
-                poisson_solve_begin(q->pp, 0.0, q->work);
-                f->diag.res_poisson = q->pp->last_residual;
-                f->diag.it_poisson = q->pp->last_iterations;
-                dc.phi = q->work;
-            } else
-                dc.phi = solve_correction(f, adt, 1);
+            dc.phi = solve_correction(f, adt, 1, dc.by_planes);
             dc.dt_stage = adt;
             pending = 1;
         } else

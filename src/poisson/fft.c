@@ -346,36 +346,32 @@ static void plane_transform(fft_t *t, double *f, int inverse, int i)
     const grid_t *g = t->p->g;
     int ny = t->ny, nz = t->nz, hz = nz / 2;
     long o = G_IDX(g, 0, 0, 0);
-    {
-        fftw_complex *w = (fftw_complex *)(t->work + i * t->PS);
-        if (inverse) fftw_execute_dft_c2r(t->pinv, w, t->pbuf);
-        for (int n1 = 0; n1 < ny; n1++) {
-            int j = !t->ynn ? n1 : n1 < ny / 2 ? 2 * n1 : 2 * (ny - 1 - n1) + 1;
-            double *restrict fr = f + G_IDX(g, i, j, 0) - o;
-            double *restrict zr = t->pbuf + (long)n1 * nz;
-            if (!t->znn) {
-                if (inverse)
-                    memcpy(fr, zr, (size_t)nz * sizeof(double));
-                else
-                    memcpy(zr, fr, (size_t)nz * sizeof(double));
-            } else if (inverse) {
-                for (int m = 0; m < hz; m++) fr[2 * m] = zr[m];
-                for (int m = 0; m < hz; m++) fr[2 * m + 1] = zr[nz - 1 - m];
-            } else {
-                for (int m = 0; m < hz; m++) zr[m] = fr[2 * m];
-                for (int m = 0; m < hz; m++) zr[nz - 1 - m] = fr[2 * m + 1];
-            }
+    fftw_complex *w = (fftw_complex *)(t->work + i * t->PS);
+    if (inverse) fftw_execute_dft_c2r(t->pinv, w, t->pbuf);
+    for (int n1 = 0; n1 < ny; n1++) {
+        int j = !t->ynn ? n1 : n1 < ny / 2 ? 2 * n1 : 2 * (ny - 1 - n1) + 1;
+        double *restrict fr = f + G_IDX(g, i, j, 0) - o;
+        double *restrict zr = t->pbuf + (long)n1 * nz;
+        if (!t->znn) {
+            if (inverse)
+                memcpy(fr, zr, (size_t)nz * sizeof(double));
+            else
+                memcpy(zr, fr, (size_t)nz * sizeof(double));
+        } else if (inverse) {
+            for (int m = 0; m < hz; m++) fr[2 * m] = zr[m];
+            for (int m = 0; m < hz; m++) fr[2 * m + 1] = zr[nz - 1 - m];
+        } else {
+            for (int m = 0; m < hz; m++) zr[m] = fr[2 * m];
+            for (int m = 0; m < hz; m++) zr[nz - 1 - m] = fr[2 * m + 1];
         }
-        if (!inverse) fftw_execute_dft_r2c(t->pfwd, t->pbuf, w);
     }
+    if (!inverse) fftw_execute_dft_r2c(t->pfwd, t->pbuf, w);
 }
 
 static void plane_transforms(fft_t *t, double *f, int inverse)
 {
     for (int i = 0; i < t->nxu; i++) plane_transform(t, f, inverse, i);
 }
-
-static void plane_inverse(fft_t *t, double *f, int i) { plane_transform(t, f, 1, i); }
 
 static void plane_plans(fft_t *t)
 {
@@ -1316,10 +1312,11 @@ static void tridiagonal_solves(fft_t *t, double lambda)
         for (int i = 0; i < nx; i++) t->tbuf[t->toff[i] + t->zcol[z]] = zsol[(long)z * nx + i];
 }
 
-static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, double *x)
+/* Everything up to the inverse transforms: the forward transforms of b, the
+ * exchanges and the tridiagonal solves; the solution's modes are in t->work. */
+static void fft_forward_and_modes(fft_t *t, double lambda, const double *b)
 {
-    fft_t *t = impl;
-    const grid_t *g = p->g;
+    const grid_t *g = t->p->g;
     long o = G_IDX(g, 0, 0, 0);
     scratch_attach(t);
     if (t->nxu > 0) {
@@ -1334,6 +1331,16 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
     if (t->P > 1)
         MPI_Alltoallv(t->recv, t->rcount, t->rdispl, MPI_DOUBLE, t->work, t->scount, t->sdispl, MPI_DOUBLE,
                       g->comm);
+    t->p->last_iterations = 1;
+    t->p->last_residual = -1.0; /* not measured (see poisson.h) */
+}
+
+static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, double *x)
+{
+    fft_t *t = impl;
+    const grid_t *g = p->g;
+    long o = G_IDX(g, 0, 0, 0);
+    fft_forward_and_modes(t, lambda, b);
     if (t->nxu > 0) {
         if (t->reord && !t->fused) fast_butterfly(t, 1);
         for (int k = 0; k < t->nsteps; k++) step_run(t, &t->inv[k], x + o);
@@ -1350,8 +1357,6 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
     for (int i = t->nxu; i < g->nxl; i++)
         for (int j = 0; j < g->n[1]; j++)
             for (int k = 0; k < nz; k++) x[G_IDX(g, i, j, k)] = 0.0;
-    p->last_iterations = 1;
-    p->last_residual = -1.0; /* not measured (see poisson.h) */
     return 0;
 }
 
@@ -1362,9 +1367,9 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
  * (plane_transforms), so a caller that reads x plane by plane — the deferred
  * correction of the fluid step — can have each plane written just before it
  * reads it, while it is in cache, instead of in a pass of its own.
- * poisson_solve_begin does all of fft_solve up to the inverse transforms;
- * poisson_solve_plane(i) is the inverse transform of plane i, the same
- * operations as in plane_transforms, so the result is bit-identical. */
+ * poisson_solve_begin is fft_solve up to the inverse transforms
+ * (fft_forward_and_modes); poisson_solve_plane(i) is plane_transform's
+ * inverse of plane i, so the result is bit-identical. */
 static int fft_by_planes(const poisson_t *p)
 {
     const fft_t *t = p->impl;
@@ -1378,19 +1383,10 @@ int poisson_solve_by_planes(const poisson_t *p) { return fft_by_planes(p); }
 void poisson_solve_begin(poisson_t *p, double lambda, const double *b)
 {
     if (!fft_by_planes(p)) die("poisson_solve_begin: not available for this solver");
-    fft_t *t = p->impl;
-    scratch_attach(t);
-    if (t->nxu > 0) plane_transforms(t, (double *)b + G_IDX(p->g, 0, 0, 0), 0);
-    tridiagonal_solves(t, lambda);
-    p->last_iterations = 1;
-    p->last_residual = -1.0;
+    fft_forward_and_modes(p->impl, lambda, b);
 }
 
-void poisson_solve_plane(poisson_t *p, double *x, int i)
-{
-    fft_t *t = p->impl;
-    plane_inverse(t, x + G_IDX(p->g, 0, 0, 0), i);
-}
+void poisson_solve_plane(poisson_t *p, double *x, int i) { plane_transform(p->impl, x + G_IDX(p->g, 0, 0, 0), 1, i); }
 
 static void fft_destroy(void *impl)
 {
