@@ -170,75 +170,88 @@ static int sphere_box(const ibm_t *ibm, const ibm_sphere_t *s, int c, int lo[3],
     return 1;
 }
 
-/* A segment of nodes along the run direction: storage index m0 of the
- * first, count len, offset r0 of the first from the sphere's centre, cell
- * size h, on grid line `line` of its plane (the y index in 3-D, 0 in 2-D). */
-typedef void (*seg_fn_t)(void *ctx, int c, int line, long m0, int len, const double r0[3], double h);
+/* Cell size h of the nodes of component c (−1: cell centres) in the grid
+ * plane of local x index il: the cube root of the control-volume extents
+ * in 3-D, the square root in 2-D (as hcell of ibm.c). */
+static double plane_cell_size(const grid_t *g, int c, int il)
+{
+    double hx = c == 0 ? g->dxc[il] : g->dxf[il];
+    return g->dim == 3 ? cbrt(hx * g->dy * g->dz) : sqrt(hx * g->dy);
+}
 
-/* Visit the segments of the nodes of component c (−1: cell centres) of
- * sphere s (box lo..hi from sphere_box) in the grid plane of unwrapped x
- * index ii, if that plane is on this rank, that lie within R_eff + band h
- * of its centre (R_eff = R − retraction h): the grid lines along the run
- * direction (z in 3-D, y in 2-D) through the box, in storage order, each
- * cut to the chord of that ball and split where a periodic face crosses
- * it.  The cost is that of the nodes returned plus one test per grid line
- * of the box. */
-static void plane_segments(const ibm_t *ibm, const ibm_sphere_t *s, int c, int ii, const int lo[3], const int hi[3],
-                           seg_fn_t fn, void *ctx)
+/* Most segments plane_segments() writes for a box lo..hi: two per grid
+ * line (a line of the box is split at most once by a periodic face, the
+ * box being narrower than the period). */
+static inline long plane_segments_max(const grid_t *g, const int lo[3], const int hi[3])
+{
+    return g->dim == 3 ? 2L * (hi[1] - lo[1] + 1) : 2L;
+}
+
+/* The segments of the nodes of component c (−1: cell centres) of sphere p
+ * (box lo..hi from sphere_box) in the grid plane of unwrapped x index ii
+ * (cell size h of plane_cell_size()), if that plane is on this rank, that
+ * lie within R_eff + band h of its centre (R_eff = R − retraction h): the
+ * grid lines along the run direction (z in 3-D, y in 2-D) through the box,
+ * in storage order, each cut to the chord of that ball and split where a
+ * periodic face crosses it.  Written to out (room for plane_segments_max())
+ * as runs of sphere p: storage index m0 of the first node, count len,
+ * offset r0 of the first from the sphere's centre, grid line `line` (the
+ * y index in 3-D, 0 in 2-D); a0 and u0 are left to the caller.  Returns
+ * their number.  The cost is that of the nodes returned plus one test per
+ * grid line of the box: no call per segment (a few hundred thousand per
+ * build). */
+static int plane_segments(const ibm_t *ibm, int p, int c, int ii, const int lo[3], const int hi[3], double h,
+                          ibm_run_t *restrict out)
 {
     const grid_t *g = ibm->g;
+    const ibm_sphere_t *s = &ibm->s[p];
     int three = g->dim == 3, rd = three ? 2 : 1;
-    int nr = g->n[rd];
+    int nr = g->n[rd], prd = g->periodic[rd], py = three && g->periodic[1];
     double hr = three ? g->dz : g->dy, offr = c == rd ? 1.0 : 0.5, band = ibm_band_halfwidth();
     int jlo = three ? lo[1] : 0, jhi = three ? hi[1] : 0;
     int iw = g->periodic[0] ? wrap(ii, g->n[0]) : ii;
-    int il = iw - g->ix0;
-    if (il < 0 || il >= g->nxl) return;
+    int il = iw - g->ix0, nout = 0;
+    if (il < 0 || il >= g->nxl) return 0;
     double r[3] = {0, 0, 0};
     r[0] = node_coord(g, 0, c, iw) + (ii - iw) / g->n[0] * g->L[0] - s->xa[0];
-    double hx = c == 0 ? g->dxc[il] : g->dxf[il];
-    double h = three ? cbrt(hx * g->dy * g->dz) : sqrt(hx * g->dy);
-    double Rout = s->radius + (band - ibm->prm.retraction) * h;
-    int jw = three && g->periodic[1] ? wrap(jlo, g->n[1]) : jlo; /* wrapped jj, carried along */
-    for (int jj = jlo; jj <= jhi; jj++, jw = three && g->periodic[1] && jw == g->n[1] - 1 ? 0 : jw + 1) {
-        double perp2 = r[0] * r[0];
+    double Rout = s->radius + (band - ibm->prm.retraction) * h, Rout2 = Rout * Rout;
+    double xs = s->xa[rd] - g->x0[rd], perp0 = r[0] * r[0];
+    /* the wrapped jj and the number of periods (jj − jw)/n_y, carried
+     * along (no integer division per line) */
+    int jw = py ? wrap(jlo, g->n[1]) : jlo, jper = (jlo - jw) / g->n[1];
+    for (int jj = jlo; jj <= jhi; jj++, jper += py && jw == g->n[1] - 1, jw = py && jw == g->n[1] - 1 ? 0 : jw + 1) {
+        double perp2 = perp0;
         if (three) {
-            r[1] = node_coord(g, 1, c, jw) + (jj - jw) / g->n[1] * g->L[1] - s->xa[1];
+            r[1] = node_coord(g, 1, c, jw) + jper * g->L[1] - s->xa[1];
             perp2 += r[1] * r[1];
         }
-        if (perp2 >= Rout * Rout) continue;
+        if (perp2 >= Rout2) continue;
         /* the chord |r_run| < √(R_out² − r_perp²), within the box */
-        double half = sqrt(Rout * Rout - perp2), xs = s->xa[rd] - g->x0[rd];
+        double half = sqrt(Rout2 - perp2);
         int a = (int)ceil((xs - half) / hr - offr), b = (int)floor((xs + half) / hr - offr);
         if (a < lo[rd]) a = lo[rd];
         if (b > hi[rd]) b = hi[rd];
         while (a <= b) {
             /* one segment: up to the next periodic face */
-            int aw = g->periodic[rd] ? wrap(a, nr) : a, len = b - a + 1;
-            if (g->periodic[rd] && aw + len > nr) len = nr - aw;
-            r[rd] = g->x0[rd] + (a + offr) * hr - s->xa[rd];
-            long m0 = three ? G_IDX(g, il, jw, aw) : G_IDX(g, il, aw, 0);
-            fn(ctx, c, three ? jw : 0, m0, len, r, h);
+            int aw = prd ? wrap(a, nr) : a, len = b - a + 1;
+            if (prd && aw + len > nr) len = nr - aw;
+            ibm_run_t *o = &out[nout++];
+            o->r0[0] = r[0];
+            o->r0[1] = r[1];
+            o->r0[2] = r[2];
+            o->r0[rd] = g->x0[rd] + (a + offr) * hr - s->xa[rd];
+            o->m0 = (int32_t)(three ? G_IDX(g, il, jw, aw) : G_IDX(g, il, aw, 0));
+            o->len = (int16_t)len;
+            o->c = (uint8_t)c;
+            o->p = p;
+            o->line = three ? jw : 0;
             a += len;
         }
     }
-}
-
-/* The same for all the planes of the box of sphere s. */
-static void for_sphere_segments(const ibm_t *ibm, const ibm_sphere_t *s, int c, seg_fn_t fn, void *ctx)
-{
-    int lo[3], hi[3];
-    if (!sphere_box(ibm, s, c, lo, hi)) return;
-    for (int ii = lo[0]; ii <= hi[0]; ii++) plane_segments(ibm, s, c, ii, lo, hi, fn, ctx);
+    return nout;
 }
 
 /* ---- node runs ------------------------------------------------------------------ */
-
-typedef struct {
-    const ibm_t *ibm;
-    ibm_priv_t *q;
-    int p;
-} build_ctx_t;
 
 /* α of the node at offset r from the centre of a sphere of radius R: the
  * profile of ibm_alpha() (the cell-centre fraction of the snapshots). */
@@ -266,6 +279,13 @@ static inline double alpha_at(double R, double band, double retraction, const do
  * alpha_at() by round-off. */
 enum { ALPHA_BATCH = 256 };
 
+/* Runs of at most RUN_SHORT nodes (nearly all at D/Δx ≲ 12) are gathered
+ * in a loop of that fixed length, the values beyond the run's end
+ * overwritten by the next run: a loop whose length varies from run to run
+ * ends in a mispredicted branch, which costs more than the few extra
+ * iterations. */
+enum { RUN_SHORT = 16 };
+
 /* The batch: the first loop (square root, divisions) without branches so
  * that the compiler vectorises it, the second the table look-up; the table
  * is 0 beyond its end, and a node at the centre, where λ is 0/0, takes its
@@ -289,28 +309,45 @@ static void alpha_batch(int n, const double *z, const double *p2, const double *
     }
 }
 
-static void alpha_runs(const ibm_t *ibm, const ibm_run_t *runs, long nr, double h, double *restrict al)
+/* α of the runs of one plane (cell size h), contiguous from al, and for
+ * each of these node entries its forced node relative to the plane's
+ * first (nid: u0 − n0 + k; room for RUN_SHORT more).  Sets each run's a0
+ * (its α from a0_first on). */
+static void alpha_runs(const ibm_t *ibm, ibm_run_t *runs, long nr, double h, long n0, long a0_first,
+                       double *restrict al, int32_t *restrict nid)
 {
     const ibm_priv_t *q = ibm_priv(ibm);
-    double z[ALPHA_BATCH], p2[ALPHA_BATCH], pa[ALPHA_BATCH], reff[ALPHA_BATCH];
+    double z[ALPHA_BATCH + RUN_SHORT], p2[ALPHA_BATCH + RUN_SHORT], pa[ALPHA_BATCH + RUN_SHORT],
+        reff[ALPHA_BATCH + RUN_SHORT], kstep[RUN_SHORT];
     double step = q->rstep, tscale = alpha_scale / (M_SQRT2 * h), retraction = ibm->prm.retraction;
     int rd = q->rdir, e = 0; /* nodes in the batch */
+    long ep = 0;             /* nodes of the plane so far */
+    for (int k = 0; k < RUN_SHORT; k++) kstep[k] = k * step;
     for (long ir = 0; ir < nr; ir++) {
-        const ibm_run_t *run = &runs[ir];
+        ibm_run_t *run = &runs[ir];
         double P2 = 0.0, PA = 0.0, R = ibm->s[run->p].radius - retraction * h, z0 = run->r0[rd];
+        int len = run->len;
+        int32_t u = (int32_t)(run->u0 - n0);
+        run->a0 = (int32_t)(a0_first + ep);
         for (int d = 0; d < 3; d++)
             if (d != rd) P2 += run->r0[d] * run->r0[d], PA += fabs(run->r0[d]);
-        if (run->len <= 64 && e + run->len <= ALPHA_BATCH) { /* the common case, without tests */
-            for (int k = 0; k < run->len; k++) {
-                z[e + k] = (z0 + 0 * step) + k * step; /* the formula below at k < 64 */
+        if (len <= RUN_SHORT && e + len <= ALPHA_BATCH) {
+            /* the common case, without tests: RUN_SHORT values, those
+             * beyond len overwritten by the next runs */
+            for (int k = 0; k < RUN_SHORT; k++) {
+                z[e + k] = (z0 + 0 * step) + kstep[k]; /* the formula below at k < 64 */
                 p2[e + k] = P2;
                 pa[e + k] = PA;
                 reff[e + k] = R;
+                nid[ep + k] = u + k;
             }
-            e += run->len;
+            e += len;
+            ep += len;
             continue;
         }
-        for (int k = 0; k < run->len; k++) {
+        for (int k = 0; k < len; k++) nid[ep + k] = u + k;
+        ep += len;
+        for (int k = 0; k < len; k++) {
             if (e == ALPHA_BATCH) {
                 alpha_batch(e, z, p2, pa, reff, tscale, al);
                 al += e;
@@ -335,23 +372,6 @@ static void grow(void **ptr, long *cap, long need, size_t sz, const char *what)
     if (!p) die_local("immersed boundary: out of memory for %ld %s", c, what);
     *ptr = p;
     *cap = c;
-}
-
-/* Record a run of sphere b->p in the plane's scratch (sorted, merged and
- * given its α with the rest of the plane). */
-static void add_run(void *ctx, int c, int line, long m0, int len, const double r0[3], double h)
-{
-    (void)h; /* = hcell[c][i] */
-    build_ctx_t *b = ctx;
-    ibm_priv_t *q = b->q;
-    grow((void **)&q->tmp, &q->cap_tmp, q->ntmp + 1, sizeof *q->tmp, "runs");
-    ibm_run_t *run = &q->tmp[q->ntmp++];
-    memcpy(run->r0, r0, sizeof run->r0);
-    run->m0 = (int32_t)m0;
-    run->len = (int16_t)len;
-    run->c = (uint8_t)c;
-    run->p = b->p;
-    run->line = line;
 }
 
 /* Storage order of two runs of a grid line: by first node, then by sphere. */
@@ -416,13 +436,25 @@ static void sort_and_merge_plane(ibm_t *ibm)
     q->nruns = nr;
 }
 
-/* α of the runs r0 .. r1−1 (one plane, nodes n0 .. n1−1), and Σ_p α_p at
- * each of its forced nodes. */
-static void compute_alpha(ibm_t *ibm, long r0, long r1, long n0, long n1)
+/* Scratch of one plane's node entries (ibm_build_nodes). */
+typedef struct {
+    int32_t *nid;  /* forced node of each entry, relative to the plane's first */
+    int32_t *cnt;  /* spheres at each forced node of the plane */
+    long cap_nid, cap_cnt;
+} plane_scratch_t;
+
+/* α of the runs r0 .. r1−1 (one plane, forced nodes n0 .. n1−1), Σ_p α_p
+ * at each of its forced nodes and the count of entries at shared nodes
+ * (nshared).  The sums go entry by entry in storage order (each node's
+ * terms in the order of its runs, as a pass run by run adds them), in one
+ * loop over all the plane's entries rather than one short loop per run
+ * (about 10 nodes at D/Δx = 10), whose varying length costs a mispredicted
+ * branch per run. */
+static void plane_alpha(ibm_t *ibm, plane_scratch_t *w, long r0, long r1, long n0, long n1)
 {
     ibm_priv_t *q = ibm_priv(ibm);
     const grid_t *g = ibm->g;
-    long n = 0;
+    long n = 0, nn = n1 - n0;
     for (long ir = r0; ir < r1; ir++) n += q->runs[ir].len;
     grow((void **)&q->alpha, &q->cap_alpha, q->nalpha + n, sizeof *q->alpha, "solid fractions");
     if (n1 > q->cap_nodes) {
@@ -432,25 +464,25 @@ static void compute_alpha(ibm_t *ibm, long r0, long r1, long n0, long n1)
         grow((void **)&q->node_imp, &cap3, n1, sizeof(double), "nodes");
         q->cap_nodes = cap;
     }
-    /* the number of spheres at each node of the plane (nshared) */
-    grow((void **)&q->cnt, &q->cap_cnt, n1 - n0, sizeof *q->cnt, "nodes");
-    memset(q->node_asum + n0, 0, (size_t)(n1 - n0) * sizeof(double));
-    memset(q->cnt, 0, (size_t)(n1 - n0) * sizeof *q->cnt);
+    grow((void **)&w->nid, &w->cap_nid, n + RUN_SHORT, sizeof *w->nid, "nodes");
+    grow((void **)&w->cnt, &w->cap_cnt, nn, sizeof *w->cnt, "nodes");
+    const double *al = q->alpha + q->nalpha;
     /* the cell size h is that of the plane */
-    alpha_runs(ibm, q->runs + r0, r1 - r0, q->hcell[q->runs[r0].c][ibm_node_i(g, q->runs[r0].m0)], q->alpha + q->nalpha);
-    for (long ir = r0; ir < r1; ir++) {
-        ibm_run_t *run = &q->runs[ir];
-        const double *al = q->alpha + q->nalpha;
-        double *A = q->node_asum + run->u0;
-        int32_t *cnt = q->cnt + (run->u0 - n0);
-        run->a0 = (int32_t)q->nalpha;
-        for (int k = 0; k < run->len; k++) {
-            A[k] += al[k];
-            cnt[k]++;
-        }
-        q->nalpha += run->len;
+    alpha_runs(ibm, q->runs + r0, r1 - r0, q->hcell[q->runs[r0].c][ibm_node_i(g, q->runs[r0].m0)], n0, q->nalpha,
+               q->alpha + q->nalpha, w->nid);
+    q->nalpha += n;
+    double *restrict A = q->node_asum + n0;
+    int32_t *restrict cnt = w->cnt;
+    const int32_t *restrict nid = w->nid;
+    memset(A, 0, (size_t)nn * sizeof *A);
+    memset(cnt, 0, (size_t)nn * sizeof *cnt);
+    for (long e = 0; e < n; e++) {
+        A[nid[e]] += al[e];
+        cnt[nid[e]]++;
     }
-    for (long j = 0; j < n1 - n0; j++) q->nshared += q->cnt[j] > 1 ? q->cnt[j] : 0;
+    long shared = 0;
+    for (long j = 0; j < nn; j++) shared += cnt[j] > 1 ? cnt[j] : 0;
+    q->nshared += shared;
 }
 
 typedef struct {
@@ -475,11 +507,11 @@ void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
-    build_ctx_t b = {.ibm = ibm, .q = q};
     if (alpha_tmax == 0.0) alpha_table_init();
     q->nruns = q->n_nruns = q->nnodes = q->nalpha = q->nshared = 0;
     if (mom) ibm_sums_zero(ibm, mom, 0, 1);
     if (targets) ibm_targets_note(ibm);
+    plane_scratch_t w = {0};
     int *box = xcalloc(7 * (size_t)(ibm->n > 0 ? ibm->n : 1), sizeof *box); /* lo[3], hi[3], in the domain */
     int32_t *head = xcalloc((size_t)g->nxl + 1, sizeof *head), *pair = NULL;
     /* the spheres by their coordinate along the run direction */
@@ -516,18 +548,24 @@ void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
         head[0] = 0;
         for (int i = 0; i < g->nxl; i++) {
             long r0 = q->nruns, n0 = q->nnodes;
+            double h = q->hcell[c][i];
             q->ntmp = 0;
             for (int k = head[i]; k < head[i + 1]; k++) {
-                b.p = pair[2 * k];
-                plane_segments(ibm, &ibm->s[b.p], c, pair[2 * k + 1], box + 7 * b.p, box + 7 * b.p + 3, add_run, &b);
+                int p = pair[2 * k];
+                const int *bx = box + 7 * p;
+                long need = q->ntmp + plane_segments_max(g, bx, bx + 3);
+                if (need > q->cap_tmp) grow((void **)&q->tmp, &q->cap_tmp, need, sizeof *q->tmp, "runs");
+                q->ntmp += plane_segments(ibm, p, c, pair[2 * k + 1], bx, bx + 3, h, q->tmp + q->ntmp);
             }
             if (q->ntmp == 0) continue;
             sort_and_merge_plane(ibm);
-            compute_alpha(ibm, r0, q->nruns, n0, q->nnodes);
+            plane_alpha(ibm, &w, r0, q->nruns, n0, q->nnodes);
             if (targets) ibm_targets_of(ibm, r0, q->nruns, n0, q->nnodes);
             if (mom) ibm_sums_of(ibm, mom, r0, q->nruns, 0, 1);
         }
     }
+    free(w.nid);
+    free(w.cnt);
     free(box);
     free(zord);
     free(head);
@@ -553,32 +591,32 @@ void ibm_solid_fraction_face(const ibm_t *ibm, int c, double *out)
     }
 }
 
-typedef struct {
-    const ibm_t *ibm;
-    double *out;
-    double R, band, retraction;
-} cell_ctx_t;
-
-static void add_cells(void *ctx, int c, int line, long m0, int len, const double r0[3], double h)
-{
-    (void)c;
-    (void)line;
-    cell_ctx_t *b = ctx;
-    const ibm_priv_t *q = ibm_priv(b->ibm);
-    double r[3] = {r0[0], r0[1], r0[2]};
-    for (int k = 0; k < len; k++, r[q->rdir] += q->rstep) {
-        long m = m0 + k * q->rstride;
-        double a = b->out[m] + alpha_at(b->R, b->band, b->retraction, r, h);
-        b->out[m] = a > 1.0 ? 1.0 : a;
-    }
-}
-
 void ibm_solid_fraction_cell(const ibm_t *ibm, double *out)
 {
-    field_zero(ibm->g, out);
-    cell_ctx_t b = {.ibm = ibm, .out = out, .band = ibm_band_halfwidth(), .retraction = ibm->prm.retraction};
+    const grid_t *g = ibm->g;
+    const ibm_priv_t *q = ibm_priv(ibm);
+    double band = ibm_band_halfwidth(), retraction = ibm->prm.retraction;
+    ibm_run_t *seg = NULL;
+    long cap = 0;
+    field_zero(g, out);
     for (int p = 0; p < ibm->n; p++) {
-        b.R = ibm->s[p].radius;
-        for_sphere_segments(ibm, &ibm->s[p], -1, add_cells, &b);
+        int lo[3], hi[3];
+        if (!sphere_box(ibm, &ibm->s[p], -1, lo, hi)) continue;
+        grow((void **)&seg, &cap, plane_segments_max(g, lo, hi), sizeof *seg, "runs");
+        for (int ii = lo[0]; ii <= hi[0]; ii++) {
+            int il = (g->periodic[0] ? wrap(ii, g->n[0]) : ii) - g->ix0;
+            if (il < 0 || il >= g->nxl) continue;
+            double h = plane_cell_size(g, -1, il);
+            int nseg = plane_segments(ibm, p, -1, ii, lo, hi, h, seg);
+            for (int e = 0; e < nseg; e++) {
+                double r[3] = {seg[e].r0[0], seg[e].r0[1], seg[e].r0[2]};
+                for (int k = 0; k < seg[e].len; k++, r[q->rdir] += q->rstep) {
+                    long m = seg[e].m0 + k * q->rstride;
+                    double a = out[m] + alpha_at(ibm->s[p].radius, band, retraction, r, h);
+                    out[m] = a > 1.0 ? 1.0 : a;
+                }
+            }
+        }
     }
+    free(seg);
 }
