@@ -381,59 +381,61 @@ static inline int run_after(const ibm_run_t *a, const ibm_run_t *b)
 }
 
 /* Sort the runs generated in one grid plane into storage order (by grid
- * line, each line's runs by m0, then by sphere)
- * and append them to the runs, merged into forced nodes: the runs of a
- * line that overlap or touch become one node run, each node once; every
- * sphere run gets the index of its first node (u0).  All of it on the
- * plane's few thousand runs, in cache. */
+ * line, each line's runs by m0, then by sphere) and append them to the
+ * runs, merged into forced nodes: the runs of a line that overlap or touch
+ * become one node run, each node once; every sphere run gets the index of
+ * its first node (u0).  All of it on the plane's few thousand runs, in
+ * cache, moving the runs themselves (no index array to follow). */
 static void sort_and_merge_plane(ibm_t *ibm)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
     long st = q->rstride, nlines = g->dim == 3 ? g->n[1] : 1;
     int32_t *head = q->line_head;
-    grow((void **)&q->order, &q->cap_order, q->ntmp, sizeof *q->order, "runs");
     grow((void **)&q->runs, &q->cap_runs, q->nruns + q->ntmp, sizeof *q->runs, "runs");
-    /* counting sort by line, then each line's few runs by m0 and sphere
-     * (insertion sort; the spheres were visited by their run coordinate,
-     * so that the runs come nearly sorted): order[head[l] .. head[l+1]) */
+    /* room for a node run per sphere run (no more node runs than runs) */
+    grow((void **)&q->nruns_f, &q->cap_nruns, q->n_nruns + q->ntmp, sizeof *q->nruns_f, "node runs");
+    /* counting sort by line into runs[head[l] .. head[l+1]), then each
+     * line's few runs by m0 and sphere (insertion sort; the spheres were
+     * visited by their run coordinate, so that the runs come nearly
+     * sorted) */
+    ibm_run_t *R = q->runs + q->nruns;
     memset(head, 0, (size_t)(nlines + 1) * sizeof *head);
     for (long ir = 0; ir < q->ntmp; ir++) head[q->tmp[ir].line + 1]++;
     for (long l = 0; l < nlines; l++) head[l + 1] += head[l];
-    for (long ir = 0; ir < q->ntmp; ir++) q->order[head[q->tmp[ir].line]++] = (int32_t)ir;
+    for (long ir = 0; ir < q->ntmp; ir++) R[head[q->tmp[ir].line]++] = q->tmp[ir];
     for (long l = nlines; l > 0; l--) head[l] = head[l - 1];
     head[0] = 0;
     for (long l = 0; l < nlines; l++) {
-        int32_t *o = q->order + head[l];
+        ibm_run_t *o = R + head[l];
         int cnt = head[l + 1] - head[l];
         for (int i = 1; i < cnt; i++) {
-            int32_t v = o[i], j = i;
-            for (; j > 0 && run_after(&q->tmp[o[j - 1]], &q->tmp[v]); j--) o[j] = o[j - 1];
+            if (!run_after(&o[i - 1], &o[i])) continue;
+            ibm_run_t v = o[i];
+            int j = i;
+            for (; j > 0 && run_after(&o[j - 1], &v); j--) o[j] = o[j - 1];
             o[j] = v;
         }
     }
-    long nr = q->nruns;
-    for (long l = 0; l < nlines; l++) {
-        int32_t e = head[l], end = head[l + 1];
-        while (e < end) {
-            long ms = q->tmp[q->order[e]].m0, me = ms - st, n0 = q->nnodes; /* first and last node */
-            for (; e < end && q->tmp[q->order[e]].m0 <= me + st; e++) {
-                ibm_run_t *o = &q->runs[nr++];
-                *o = q->tmp[q->order[e]];
-                o->u0 = (int32_t)(n0 + (st == 1 ? o->m0 - ms : (o->m0 - ms) / st));
-                long oe = o->m0 + (o->len - 1) * st;
-                if (oe > me) me = oe;
-            }
-            grow((void **)&q->nruns_f, &q->cap_nruns, q->n_nruns + 1, sizeof *q->nruns_f, "node runs");
-            ibm_node_run_t *n = &q->nruns_f[q->n_nruns++];
-            n->m0 = (int32_t)ms;
-            n->n0 = (int32_t)n0;
-            n->len = (int32_t)((me - ms) / st + 1);
-            n->c = q->runs[nr - 1].c;
-            q->nnodes += n->len;
+    /* merge, line by line (the runs of a line are contiguous now) */
+    long e = 0, end = q->ntmp;
+    while (e < end) {
+        long ms = R[e].m0, me = ms - st, n0 = q->nnodes; /* first and last node */
+        int32_t line = R[e].line;
+        for (; e < end && R[e].line == line && R[e].m0 <= me + st; e++) {
+            ibm_run_t *o = &R[e];
+            o->u0 = (int32_t)(n0 + (st == 1 ? o->m0 - ms : (o->m0 - ms) / st));
+            long oe = o->m0 + (o->len - 1) * st;
+            if (oe > me) me = oe;
         }
+        ibm_node_run_t *n = &q->nruns_f[q->n_nruns++];
+        n->m0 = (int32_t)ms;
+        n->n0 = (int32_t)n0;
+        n->len = (int32_t)(st == 1 ? me - ms + 1 : (me - ms) / st + 1);
+        n->c = R[e - 1].c;
+        q->nnodes += n->len;
     }
-    q->nruns = nr;
+    q->nruns += q->ntmp;
 }
 
 /* Scratch of one plane's node entries (ibm_build_nodes). */
