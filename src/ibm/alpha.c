@@ -438,13 +438,6 @@ static void sort_and_merge_plane(ibm_t *ibm)
     q->nruns += q->ntmp;
 }
 
-/* Scratch of one plane's node entries (ibm_build_nodes). */
-typedef struct {
-    int32_t *nid;  /* forced node of each entry, relative to the plane's first */
-    int32_t *cnt;  /* spheres at each forced node of the plane */
-    long cap_nid, cap_cnt;
-} plane_scratch_t;
-
 /* α of the runs r0 .. r1−1 (one plane, forced nodes n0 .. n1−1), Σ_p α_p
  * at each of its forced nodes and the count of entries at shared nodes
  * (nshared).  The sums go entry by entry in storage order (each node's
@@ -452,7 +445,7 @@ typedef struct {
  * loop over all the plane's entries rather than one short loop per run
  * (about 10 nodes at D/Δx = 10), whose varying length costs a mispredicted
  * branch per run. */
-static void plane_alpha(ibm_t *ibm, plane_scratch_t *w, long r0, long r1, long n0, long n1)
+static void plane_alpha(ibm_t *ibm, long r0, long r1, long n0, long n1)
 {
     ibm_priv_t *q = ibm_priv(ibm);
     const grid_t *g = ibm->g;
@@ -466,16 +459,18 @@ static void plane_alpha(ibm_t *ibm, plane_scratch_t *w, long r0, long r1, long n
         grow((void **)&q->node_imp, &cap3, n1, sizeof(double), "nodes");
         q->cap_nodes = cap;
     }
-    grow((void **)&w->nid, &w->cap_nid, n + RUN_SHORT, sizeof *w->nid, "nodes");
-    grow((void **)&w->cnt, &w->cap_cnt, nn, sizeof *w->cnt, "nodes");
+    /* scratch: the forced node of each entry (in order[]), the number of
+     * spheres at each node (cnt[]) */
+    grow((void **)&q->order, &q->cap_order, n + RUN_SHORT, sizeof *q->order, "nodes");
+    grow((void **)&q->cnt, &q->cap_cnt, nn, sizeof *q->cnt, "nodes");
     const double *al = q->alpha + q->nalpha;
     /* the cell size h is that of the plane */
     alpha_runs(ibm, q->runs + r0, r1 - r0, q->hcell[q->runs[r0].c][ibm_node_i(g, q->runs[r0].m0)], n0, q->nalpha,
-               q->alpha + q->nalpha, w->nid);
+               q->alpha + q->nalpha, q->order);
     q->nalpha += n;
     double *restrict A = q->node_asum + n0;
-    int32_t *restrict cnt = w->cnt;
-    const int32_t *restrict nid = w->nid;
+    int32_t *restrict cnt = q->cnt;
+    const int32_t *restrict nid = q->order;
     memset(A, 0, (size_t)nn * sizeof *A);
     memset(cnt, 0, (size_t)nn * sizeof *cnt);
     for (long e = 0; e < n; e++) {
@@ -513,7 +508,6 @@ void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
     q->nruns = q->n_nruns = q->nnodes = q->nalpha = q->nshared = 0;
     if (mom) ibm_sums_zero(ibm, mom, 0, 1);
     if (targets) ibm_targets_note(ibm);
-    plane_scratch_t w = {0};
     int *box = xcalloc(7 * (size_t)(ibm->n > 0 ? ibm->n : 1), sizeof *box); /* lo[3], hi[3], in the domain */
     int32_t *head = xcalloc((size_t)g->nxl + 1, sizeof *head), *pair = NULL;
     /* the spheres by their coordinate along the run direction */
@@ -561,13 +555,11 @@ void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
             }
             if (q->ntmp == 0) continue;
             sort_and_merge_plane(ibm);
-            plane_alpha(ibm, &w, r0, q->nruns, n0, q->nnodes);
+            plane_alpha(ibm, r0, q->nruns, n0, q->nnodes);
             if (targets) ibm_targets_of(ibm, r0, q->nruns, n0, q->nnodes);
             if (mom) ibm_sums_of(ibm, mom, r0, q->nruns, 0, 1);
         }
     }
-    free(w.nid);
-    free(w.cnt);
     free(box);
     free(zord);
     free(head);

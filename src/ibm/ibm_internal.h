@@ -63,8 +63,9 @@ typedef struct {
     double *node_asum, *node_target, *node_imp;
     long nnodes, cap_nodes;
     /* scratch of the build, one plane at a time (alpha.c): the runs as
-     * generated, their sorted order, the first of each grid line's runs in
-     * it, and the number of spheres at each node */
+     * generated, the first of each grid line's runs among the sorted ones,
+     * the forced node of each node entry (order) and the number of spheres
+     * at each node (cnt) */
     ibm_run_t *tmp;
     long ntmp, cap_tmp;
     int32_t *order, *line_head, *cnt;
