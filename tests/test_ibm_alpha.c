@@ -6,6 +6,7 @@
  * size.
  * RANKS: 1 2
  */
+#include "../src/ibm/ibm_internal.h" /* the node lists: ibm_build_nodes and its separate passes */
 #include "ibmtest.h"
 #include "modules.h"
 #include "testutil.h"
@@ -212,6 +213,79 @@ static void test_lists_against_brute_force(void **state)
                 "axisymmetric");
 }
 
+/* ---- the build's sums against the separate passes ------------------------------------ */
+
+/* The build fuses Σα (one loop over a plane's entries, with the count of
+ * spheres per node), the targets and the momentum into one visit per grid
+ * plane.  Each must give exactly what the plain definition gives, term by
+ * term in storage order from +0: Σα run by run, the targets and the
+ * momentum of the whole-list passes set_targets() and ibm_momentum() use.
+ * Exact equality (memcmp): the same operations in the same order — any
+ * reordering would show in the last bit somewhere among the ~10⁴ sums. */
+static void check_build_sums(const char *text, const char *what)
+{
+    it_case_t tc = it_from_case(text);
+    ibm_t *ibm = tc.ibm;
+    ibm_priv_t *q = ibm_priv(ibm);
+    const grid_t *g = tc.g;
+    for (int c = 0; c < 3; c++)
+        if (tc.f->u[c])
+            for (long m = 0; m < g->nalloc; m++) tc.f->u[c][m] = sin(0.37 * m + c) + 0.1 * c; /* any field */
+    size_t nsum = (size_t)ibm->n * IBM_NSUM;
+    double *mom = xcalloc(nsum, sizeof *mom), *mom_pass = xcalloc(nsum, sizeof *mom_pass);
+    ibm_build_nodes(ibm, mom, 1);
+    long nn = q->nnodes;
+    double *T = xcalloc((size_t)nn + 1, sizeof *T), *A = xcalloc((size_t)nn + 1, sizeof *A);
+    int *cnt = xcalloc((size_t)nn + 1, sizeof *cnt);
+    memcpy(T, q->node_target, (size_t)nn * sizeof *T);
+    for (long ir = 0; ir < q->nruns; ir++)
+        for (int k = 0; k < q->runs[ir].len; k++) {
+            A[q->runs[ir].u0 + k] += q->alpha[q->runs[ir].a0 + k];
+            cnt[q->runs[ir].u0 + k]++;
+        }
+    long shared = 0;
+    for (long j = 0; j < nn; j++) shared += cnt[j] > 1 ? cnt[j] : 0;
+    ibm_targets_of(ibm, 0, q->nruns, 0, nn);
+    ibm_momentum(ibm, mom_pass);
+    int same_a = nn == 0 || !memcmp(A, q->node_asum, (size_t)nn * sizeof *A);
+    int same_t = nn == 0 || !memcmp(T, q->node_target, (size_t)nn * sizeof *T);
+    int same_m = !memcmp(mom, mom_pass, nsum * sizeof *mom);
+    print_message("  %s (rank %d): %ld forced nodes, %ld entries, %ld shared (%ld counted): Σα %s, targets %s, momentum %s\n",
+                  what, g->rank, nn, q->nalpha, q->nshared, shared, same_a ? "identical" : "DIFFERENT",
+                  same_t ? "identical" : "DIFFERENT", same_m ? "identical" : "DIFFERENT");
+    assert_true(same_a && same_t && same_m);
+    assert_int_equal(q->nshared, shared);
+    assert_true(grid_sum(g, (double)shared) > 0); /* the scenes have overlapping spheres */
+    free(T);
+    free(A);
+    free(cnt);
+    free(mom);
+    free(mom_pass);
+    it_free(&tc);
+}
+
+static void test_build_sums_exact(void **state)
+{
+    (void)state;
+    /* moving, rotating spheres: overlapping (three at some nodes), across
+     * the periodic x and y faces, against the z wall; runs of up to 24
+     * nodes (longer than the build's fixed-length loops) */
+    check_build_sums("[domain]\nnx = 32\nny = 28\nnz = 26\nlength = 2.4 2.1 1.95\n"
+                     "[boundary]\nz_lo = noslip\nz_hi = noslip\n[fluid]\nnu = 1\n"
+                     "[ibm]\nsphere1 = prescribed center 0.05 1.0 0.7 radius 0.5 velocity 0.3 -0.2 0.1 omega 1 2 -3\n"
+                     "sphere2 = prescribed center 1.2 2.05 0.75 radius 0.25 velocity -0.1 0.2 0.4 omega -2 1 0.5\n"
+                     "sphere3 = prescribed center 1.1 0.6 0.5 radius 0.2 velocity 0.2 0.1 -0.3 omega 0.3 -1 2\n"
+                     "sphere4 = prescribed center 1.32 0.72 0.55 radius 0.22 velocity 0 0.5 0 omega 1 1 1\n"
+                     "sphere5 = prescribed center 1.25 0.55 0.68 radius 0.2 velocity 0.1 0 0 omega 0 0 1\n"
+                     "sphere6 = prescribed center 1.7 0.4 0.12 radius 0.18 velocity 0.05 0.05 0.05 omega 2 0 0\n",
+                     "3-D");
+    check_build_sums("[domain]\ngeometry = 2d\nnx = 32\nny = 24\nlength = 2 1.5 1\n"
+                     "[boundary]\ny_lo = noslip\ny_hi = freeslip\n[fluid]\nnu = 1\n"
+                     "[ibm]\nsphere1 = prescribed center 1.97 0.7 0 radius 0.3 velocity 0.2 0.1 0 omega 0 0 2\n"
+                     "sphere2 = prescribed center 1.7 0.6 0 radius 0.2 velocity -0.1 0.3 0 omega 0 0 -1\n",
+                     "2-D discs");
+}
+
 /* ---- cost ---------------------------------------------------------------------------- */
 
 /* The same sphere at the same Δx in boxes of 24³ and 48³ cells has the
@@ -247,6 +321,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_volume_3d),
         cmocka_unit_test(test_volume_axi_2d),
         cmocka_unit_test(test_lists_against_brute_force),
+        cmocka_unit_test(test_build_sums_exact),
         cmocka_unit_test(test_cost_independent_of_grid),
     };
     TEST_MPI_RUN("ibm_alpha", tests);
