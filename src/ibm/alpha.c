@@ -216,6 +216,15 @@ static int plane_segments(const ibm_t *ibm, int p, int c, int ii, const int lo[3
     r[0] = node_coord(g, 0, c, iw) + (ii - iw) / g->n[0] * g->L[0] - s->xa[0];
     double Rout = s->radius + (band - ibm->prm.retraction) * h, Rout2 = Rout * Rout;
     double xs = s->xa[rd] - g->x0[rd], perp0 = r[0] * r[0];
+    if (perp0 >= Rout2) return 0; /* the plane misses the ball */
+    if (three) {
+        /* the lines that may reach the ball, with a line of margin either
+         * side (each is still tested below, as if all were visited) */
+        double half = sqrt(Rout2 - perp0), ys = (s->xa[1] - g->x0[1]) / g->dy - (c == 1 ? 1.0 : 0.5);
+        double ja = floor(ys - half / g->dy) - 1, jb = ceil(ys + half / g->dy) + 1;
+        if (ja > jlo) jlo = (int)ja;
+        if (jb < jhi) jhi = (int)jb;
+    }
     /* the wrapped jj and the number of periods (jj − jw)/n_y, carried
      * along (no integer division per line) */
     int jw = py ? wrap(jlo, g->n[1]) : jlo, jper = (jlo - jw) / g->n[1];
