@@ -14,9 +14,11 @@
  * and torque of the step after fluid_step(); within the step an external
  * sphere's solid fraction stays where it was put, forced with U + ω × r).
  *
- * It works through the fluid's two stage hooks (fluid.h): at every RK3
- * stage, before the projection, the predicted velocity is forced towards the
- * rigid-body velocity U + ω × r of each sphere,
+ * It works through the fluid's hooks (fluid.h): at every RK3 stage, before
+ * the predictor sweep, the targets are set (and at the first stage the moves
+ * made between steps applied); on each plane of the predicted velocity, as
+ * the sweep writes it, that velocity is forced towards the rigid-body
+ * velocity U + ω × r of each sphere,
  *     u ← u + β (U − u)      (f = β (U − u*)/Δt_k),
  * with α the smoothed solid fraction of decision 1 at each staggered node
  * and β = α (the seed's forcing) or its time-step independent form
@@ -120,8 +122,8 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
 /* Default parameters (momentum model, C_v = 0.1, the seed's forcing, no
  * iterations, no retraction, no gravity). */
 ibm_params_t ibm_default_params(void);
-/* Build for the fluid f with n spheres (copied) and install the stage hooks
- * (f->stage_hook, f->stage_end_hook).  Dies on spheres that do not fit the
+/* Build for the fluid f with n spheres (copied) and install the fluid's
+ * hooks (stage begin, plane, stage, stage end).  Dies on spheres that do not fit the
  * grid (e.g. off the axis of an axisymmetric grid). */
 ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, int n);
 /* Remove the hooks and free. */

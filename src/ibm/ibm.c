@@ -167,7 +167,8 @@ static const char *sphere_misfit(const grid_t *g, const ibm_sphere_t *s)
 ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, int n)
 {
     const grid_t *g = f->g;
-    if (f->stage_hook || f->stage_end_hook) die("immersed boundary: the fluid's stage hooks are already in use");
+    if (f->stage_begin_hook || f->plane_hook || f->stage_hook || f->stage_end_hook)
+        die("immersed boundary: the fluid's stage hooks are already in use");
     if (g->nalloc >= INT32_MAX) die("immersed boundary: a field of %ld values is too large for the node lists", g->nalloc);
     for (int d = 0; d < g->dim; d++)
         if (g->periodic[d] && g->n[d] > 127 * 1000000) die("immersed boundary: grid too large");
@@ -210,9 +211,13 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
     q->mom_prev = xcalloc(nn * 6, sizeof(double));
     q->target_vel = xcalloc(nn * 6, sizeof(double));
     q->imp_step = xcalloc(nn * 6, sizeof(double));
+    q->plane_nrun = xcalloc((size_t)g->dim * ((size_t)g->nxl + 1), sizeof *q->plane_nrun);
+    f->stage_begin_hook = ibm_stage_begin;
+    f->plane_hook = ibm_force_plane;
     f->stage_hook = ibm_stage_force;
     f->stage_end_hook = ibm_stage_end;
     f->hook_ctx = ibm;
+    f->hook_flags = 0;
     ibm_update_geometry(ibm);
     return ibm;
 }
@@ -222,9 +227,12 @@ void ibm_free(ibm_t *ibm)
     if (!ibm) return;
     ibm_priv_t *q = ibm_priv(ibm);
     if (ibm->f->hook_ctx == ibm) {
+        ibm->f->stage_begin_hook = NULL;
+        ibm->f->plane_hook = NULL;
         ibm->f->stage_hook = NULL;
         ibm->f->stage_end_hook = NULL;
         ibm->f->hook_ctx = NULL;
+        ibm->f->hook_flags = 0;
     }
     for (int c = 0; c < 3; c++) {
         if (q->vol[c]) free(q->vol[c] - 1);
@@ -249,6 +257,7 @@ void ibm_free(ibm_t *ibm)
     free(q->mom_prev);
     free(q->target_vel);
     free(q->imp_step);
+    free(q->plane_nrun);
     free(q);
     free(ibm->s);
     free(ibm);
