@@ -14,6 +14,8 @@
  *   external_rest    external spheres at rest (α built once);
  *   free             free spheres (ρ_p/ρ = 2 under gravity): α rebuilt
  *                    after every stage.
+ *   free_step        the same with [ibm] free_alpha = step: α held over the
+ *                    step, rebuilt once per step.
  * Every repetition times one step of the fluid alone (the immersed
  * boundary's hooks detached) and then one step with the spheres, so that
  * both see the same machine state; the best of each is kept.  The cost of
@@ -162,14 +164,16 @@ int main(int argc, char **argv)
     static const struct {
         const char *name, *what;
         ibm_kind_t kind;
-        int move;
+        int move, free_step;
     } variant[] = {
         {"external_moving", "external spheres (DEM-coupled) moved by 0.01 dx between steps, alpha rebuilt every step",
-         IBM_EXTERNAL, 1},
-        {"external_rest", "external spheres at rest (alpha built once)", IBM_EXTERNAL, 0},
-        {"free", "free spheres (rho_p/rho = 2 under gravity, alpha rebuilt at every stage)", IBM_FREE, 0},
+         IBM_EXTERNAL, 1, 0},
+        {"external_rest", "external spheres at rest (alpha built once)", IBM_EXTERNAL, 0, 0},
+        {"free", "free spheres (rho_p/rho = 2 under gravity, alpha rebuilt at every stage)", IBM_FREE, 0, 0},
+        {"free_step", "free spheres, [ibm] free_alpha = step (alpha held over the step, rebuilt once per step)",
+         IBM_FREE, 0, 1},
     };
-    for (int v = 0; v < 3; v++) {
+    for (int v = 0; v < 4; v++) {
         if (only && strcmp(only, variant[v].name)) continue;
         for (int p = 0; p < count; p++) {
             s[p].kind = variant[v].kind;
@@ -178,6 +182,7 @@ int main(int argc, char **argv)
         }
         ibm_params_t ip = ibm_default_params();
         ip.gravity[1] = -1.0;
+        ip.free_alpha_per_step = variant[v].free_step;
         ibm_t *ibm = ibm_create(f, &ip, s, count);
         /* external spheres: a small displacement between steps along a fixed
          * random direction per sphere, as the DEM would make, with the

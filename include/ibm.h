@@ -88,6 +88,8 @@ typedef struct {
     double retraction;    /* α is taken for the radius R − retraction × h (h the cell size) */
     double forcing_time;  /* κ: partially covered nodes relax towards U with the time scale
                            * τ = κ h²/ν (0: the seed's u ← u + α (U − u) at every stage) */
+    int free_alpha_per_step; /* 1: a free sphere's α is held over the fluid step and moved
+                              * between steps (docs/theory.md §6b); 0: moved after every stage */
 } ibm_params_t;
 
 typedef struct ibm ibm_t;

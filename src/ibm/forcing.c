@@ -324,6 +324,16 @@ static void displacement(const grid_t *g, const double a[3], const double b[3], 
  * where it was put over the three stages. */
 static inline int still_within_step(const ibm_sphere_t *s) { return s->kind == IBM_FIXED || s->kind == IBM_EXTERNAL; }
 
+/* Is the solid fraction of sphere s held where the step started over its
+ * three stages?  Fixed and external spheres, and free ones with
+ * free_alpha = step: those move (x, u, ω change at every stage) but their α
+ * is moved between steps, like an external sphere's, with the whole jump
+ * counted (xpred = x: λ = 1 in carry_external_moves). */
+static inline int alpha_held(const ibm_t *ibm, const ibm_sphere_t *s)
+{
+    return still_within_step(s) || (s->kind == IBM_FREE && ibm->prm.free_alpha_per_step);
+}
+
 /* Do all spheres keep their position and velocity over the fluid step
  * (fixed spheres, and external ones, which the coupling moves between
  * steps)?  Then the solid fraction and the targets Ū stay as they are over
@@ -360,7 +370,7 @@ static int carry_external_moves(ibm_t *ibm)
     char *mv = xcalloc((size_t)ibm->n, 1);
     for (int p = 0; p < ibm->n; p++) {
         ibm_sphere_t *s = &ibm->s[p];
-        if (!still_within_step(s) || !memcmp(s->xa, s->x, sizeof s->x)) continue;
+        if (!alpha_held(ibm, s) || !memcmp(s->xa, s->x, sizeof s->x)) continue;
         double dx[3], dp[3], *I = q->mom_prev + 6 * p, *L = I + 3, dd = 0, dpd = 0;
         displacement(ibm->g, s->xa, s->x, dx);
         displacement(ibm->g, s->xa, s->xpred, dp);
@@ -414,7 +424,7 @@ void ibm_update_geometry(ibm_t *ibm)
     for (int p = 0; p < ibm->n; p++) memcpy(ibm->s[p].xa, ibm->s[p].x, sizeof ibm->s[p].x);
     ibm_rebuild_geometry(ibm);
     for (int p = 0; p < ibm->n; p++)
-        if (still_within_step(&ibm->s[p]))
+        if (alpha_held(ibm, &ibm->s[p]))
             memcpy(q->mom_prev + 6 * p, keep + 6 * p, 6 * sizeof(double));
     free(keep);
 }
@@ -437,7 +447,7 @@ void ibm_stage_begin(fluid_t *f, int stage, double dt_stage, void *ctx)
         memset(q->imp_step, 0, (size_t)ibm->n * 6 * sizeof(double));
         q->frozen = step_frozen(ibm);
         /* the moves made since the last step (ibm_update_geometry) */
-        if (q->frozen) carry_external_moves(ibm);
+        if (q->frozen || ibm->prm.free_alpha_per_step) carry_external_moves(ibm);
         f->hook_flags = (ibm->prm.forcing_iterations == 0 ? FLUID_HOOK_KEEPS_USTAR : 0) |
                         (q->frozen ? FLUID_HOOK_IDLE_UK : 0);
     }
@@ -504,6 +514,7 @@ static void mask_geometry(const grid_t *g, double v[3], double w[3])
 static void predict_centre(const ibm_t *ibm, ibm_sphere_t *s, double dt, double t_end)
 {
     double u1[3], w1[3];
+    if (s->kind == IBM_FREE && ibm->prm.free_alpha_per_step) return; /* α held over the step */
     switch (s->kind) {
     case IBM_FIXED:
     case IBM_EXTERNAL: memcpy(s->xa, s->x, sizeof s->xa); return; /* moved between steps only */
@@ -548,7 +559,7 @@ static void update_sphere(ibm_t *ibm, int p, double dt, double t_end, double J[3
     memcpy(w0, s->omega, sizeof w0);
     /* the reference point of L moves with the solid fraction: not so for
      * fixed and external spheres, whose α stays where it is over the step */
-    double dt_ref = still_within_step(s) ? 0.0 : dt;
+    double dt_ref = alpha_held(ibm, s) ? 0.0 : dt;
     for (int c = 0; c < 3; c++) {
         J[c] = rho * (sum[IBM_MOM + c] - prev[c] - sum[IBM_FIMP + c]);
         K[c] = rho * (sum[IBM_ANG + c] - prev[3 + c] + dt_ref * uxI[c] - sum[IBM_TIMP + c]);
@@ -657,12 +668,17 @@ void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx)
         for (int d = 0; d < 6; d++) q->mom_prev[6 * p + d] = q->sum[(long)p * IBM_NSUM + IBM_MOM + d];
     }
     if (stage == 2)
-        for (int p = 0; p < ibm->n; p++)
+        for (int p = 0; p < ibm->n; p++) {
+            ibm_sphere_t *s = &ibm->s[p];
+            /* a free sphere whose α was held: its own motion over the step,
+             * all of it counted when α is moved (λ = 1) */
+            int own = s->kind == IBM_FREE && ibm->prm.free_alpha_per_step;
             for (int d = 0; d < 3; d++) {
-                ibm->s[p].force[d] = q->imp_step[6 * p + d] / q->t_step;
-                ibm->s[p].torque[d] = q->imp_step[6 * p + 3 + d] / q->t_step;
-                ibm->s[p].xpred[d] = ibm->s[p].xa[d] + q->t_step * ibm->s[p].u[d];
+                s->force[d] = q->imp_step[6 * p + d] / q->t_step;
+                s->torque[d] = q->imp_step[6 * p + 3 + d] / q->t_step;
+                s->xpred[d] = own ? s->x[d] : s->xa[d] + q->t_step * s->u[d];
             }
+        }
     ibm->wall_alpha += w1 - w0;
     ibm->wall_integrals += wtime() - w1;
 }

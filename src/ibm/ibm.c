@@ -33,6 +33,11 @@ static const cfg_key_t ibm_keys[] = {
     {"ibm", "forcing_time", CFG_DOUBLE, "0", 0, 1e6, NULL,
      "κ: a node of solid fraction α < 1 is forced by u ← u + β(U − u), β = αΔt_k/((1−α)κh²/ν + αΔt_k), whose "
      "steady state does not depend on the time step; 0: the seed's β = α at every stage (depends on Δt)"},
+    {"ibm", "free_alpha", CFG_ENUM, "stage", 1, 0, "stage|step",
+     "where a free sphere's solid fraction is over a fluid step: moved to the predicted centre after every "
+     "Runge-Kutta stage (stage), or held where the step started and moved between steps, the fluid momentum "
+     "over the jump counted in the next force (step: one rebuild per step instead of three, see "
+     "docs/theory.md)"},
     {"ibm", "retraction", CFG_DOUBLE, "0", -1, 1, NULL,
      "the solid fraction is that of a sphere of radius R - retraction × Δx (cells): compensates the effective "
      "thickening of the forced sphere (0: the seed's method)"},
@@ -494,6 +499,7 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
     cfg_vec3(cfg, "ibm", "gravity", prm.gravity);
     prm.retraction = cfg_double(cfg, "ibm", "retraction");
     prm.forcing_time = cfg_double(cfg, "ibm", "forcing_time");
+    prm.free_alpha_per_step = cfg_enum(cfg, "ibm", "free_alpha");
     if (g->geom == GEOM_AXI && (prm.gravity[0] != 0.0 || prm.gravity[2] != 0.0))
         cfg_fail(cfg, "ibm", "gravity", "an axisymmetric gravity must be axial (y)");
     if (g->dim == 2 && prm.gravity[2] != 0.0) cfg_fail(cfg, "ibm", "gravity", "a 2-D grid has no z direction");
