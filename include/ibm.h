@@ -104,6 +104,7 @@ struct ibm {
      * integrals, particle update) since creation */
     double wall_alpha, wall_forcing, wall_integrals;
     long nodes_forced;     /* node entries (sphere, node) of the last stage, this rank */
+    long nodes_distinct;   /* ... the distinct nodes they cover (each forced once) */
     long nodes_shared;     /* ... of them at nodes that another sphere's band reaches too */
     void *priv;
 };

@@ -188,6 +188,7 @@ static void index_planes(ibm_t *ibm)
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
     long np = (long)g->nxl + 1;
+    ibm->nodes_distinct = q->nnodes;
     for (int c = 0; c < g->dim; c++)
         for (int i = 0; i <= g->nxl; i++) {
             /* first node run whose (component, plane) is not below (c, i) */
