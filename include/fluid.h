@@ -20,6 +20,25 @@ typedef struct fluid fluid_t;
  * divergence-free, ghosts filled): the immersed boundary measures the fluid
  * momentum inside the particles there and moves them. */
 typedef void (*fluid_stage_hook_t)(fluid_t *f, int stage, double dt_stage, void *ctx);
+/* Called for every local x plane i (0 .. nxl − 1, in order) of the predicted
+ * velocity u* (the arrays ustar[c], which are not yet f->u inside the sweep)
+ * once all its components are written, before the projection: may modify
+ * u* at the unknowns of plane i (not its ghosts, not other planes).  Inside the predictor sweep when the fluid can (3-D, explicit
+ * viscous term, no quadratic wall ghost: docs/theory.md §1, step 1.1b), so
+ * that the plane is still in cache; otherwise plane by plane after the
+ * sweep (and the Crank–Nicolson solves).  Either way before the stage hook
+ * and with the same result. */
+typedef void (*fluid_plane_hook_t)(fluid_t *f, double *const ustar[3], int stage, double dt_stage, int i, void *ctx);
+
+/* Promises a hook owner makes in f->hook_flags (what the fluid may then fuse):
+ *  FLUID_HOOK_KEEPS_USTAR  the stage hook reads u* but does not change it (the
+ *                          divergence of u* may be formed inside the sweep);
+ *  FLUID_HOOK_IDLE_UK      in this step, the stage-end hooks of stages 0 and 1
+ *                          and the stage-begin hooks of stages 1 and 2 read
+ *                          neither u nor p (the corrections of stages 0 and 1
+ *                          may be deferred into the next sweep).
+ * The fluid reads them after the stage-begin hook of stage 0, for the step. */
+enum { FLUID_HOOK_KEEPS_USTAR = 1, FLUID_HOOK_IDLE_UK = 2 };
 
 /* Coefficients of the low-storage RK3 (step.c): stage k advances by
  * (γ_k + ζ_k) Δt, i.e. to t + (8/15, 2/3, 1) Δt. */
@@ -43,6 +62,9 @@ typedef struct {
     double dt_fixed;      /* > 0: constant time step */
     double dt_max;
     poisson_opts_t poisson;
+    int unfused;          /* verification switch, not a case-file key: every pass of the step on
+                           * its own (no plane hook, divergence or correction inside the sweeps);
+                           * bit-identical results (tests/test_ibm_fused.c, test_fluid_ops.c) */
 } fluid_params_t;
 
 typedef struct {
@@ -64,9 +86,12 @@ struct fluid {
     double time;
     long step;
     fluid_diag_t diag;
-    fluid_stage_hook_t stage_hook;     /* before each projection (may be NULL) */
-    fluid_stage_hook_t stage_end_hook; /* after each projection (may be NULL) */
-    void *hook_ctx;                    /* passed to both hooks */
+    fluid_stage_hook_t stage_begin_hook; /* before each predictor sweep (may be NULL) */
+    fluid_plane_hook_t plane_hook;       /* on each plane of u* (may be NULL) */
+    fluid_stage_hook_t stage_hook;       /* before each projection (may be NULL) */
+    fluid_stage_hook_t stage_end_hook;   /* after each projection (may be NULL) */
+    void *hook_ctx;                      /* passed to all hooks */
+    int hook_flags;                      /* FLUID_HOOK_* */
     void *priv;           /* work arrays and solvers of the implementation */
 };
 

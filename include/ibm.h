@@ -14,9 +14,11 @@
  * and torque of the step after fluid_step(); within the step an external
  * sphere's solid fraction stays where it was put, forced with U + ω × r).
  *
- * It works through the fluid's two stage hooks (fluid.h): at every RK3
- * stage, before the projection, the predicted velocity is forced towards the
- * rigid-body velocity U + ω × r of each sphere,
+ * It works through the fluid's hooks (fluid.h): at every RK3 stage, before
+ * the predictor sweep, the targets are set (and at the first stage the moves
+ * made between steps applied); on each plane of the predicted velocity, as
+ * the sweep writes it, that velocity is forced towards the rigid-body
+ * velocity U + ω × r of each sphere,
  *     u ← u + β (U − u)      (f = β (U − u*)/Δt_k),
  * with α the smoothed solid fraction of decision 1 at each staggered node
  * and β = α (the seed's forcing) or its time-step independent form
@@ -86,6 +88,8 @@ typedef struct {
     double retraction;    /* α is taken for the radius R − retraction × h (h the cell size) */
     double forcing_time;  /* κ: partially covered nodes relax towards U with the time scale
                            * τ = κ h²/ν (0: the seed's u ← u + α (U − u) at every stage) */
+    int free_alpha_per_step; /* 1: a free sphere's α is held over the fluid step and moved
+                              * between steps (docs/theory.md §6b); 0: moved after every stage */
 } ibm_params_t;
 
 typedef struct ibm ibm_t;
@@ -100,6 +104,7 @@ struct ibm {
      * integrals, particle update) since creation */
     double wall_alpha, wall_forcing, wall_integrals;
     long nodes_forced;     /* node entries (sphere, node) of the last stage, this rank */
+    long nodes_distinct;   /* ... the distinct nodes they cover (each forced once) */
     long nodes_shared;     /* ... of them at nodes that another sphere's band reaches too */
     void *priv;
 };
@@ -120,8 +125,8 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
 /* Default parameters (momentum model, C_v = 0.1, the seed's forcing, no
  * iterations, no retraction, no gravity). */
 ibm_params_t ibm_default_params(void);
-/* Build for the fluid f with n spheres (copied) and install the stage hooks
- * (f->stage_hook, f->stage_end_hook).  Dies on spheres that do not fit the
+/* Build for the fluid f with n spheres (copied) and install the fluid's
+ * hooks (stage begin, plane, stage, stage end).  Dies on spheres that do not fit the
  * grid (e.g. off the axis of an axisymmetric grid). */
 ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, int n);
 /* Remove the hooks and free. */

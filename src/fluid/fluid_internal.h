@@ -77,14 +77,16 @@ void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double
  * fluid_interior; the caller completes it with fluid_divergence_rest), and
  * with `ahead` (or NULL) called before each x plane i is swept: it must
  * leave planes i − 1 … i + 1 of u and p final, ghosts included (step.c's
- * deferred correction) */
+ * deferred correction); `done` (or NULL) is called when plane i of u* is
+ * written, before its divergence: it may change u* on plane i (step.c's
+ * plane hook: the immersed-boundary forcing) */
 typedef struct {
     void (*fn)(void *ctx, int i);
     void *ctx;
 } fluid_ahead_t;
 void fluid_rhs_predict_div(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
                            double *const H[3], double *const US[3], double div_scale, double *div,
-                           const fluid_ahead_t *ahead);
+                           const fluid_ahead_t *ahead, const fluid_ahead_t *done);
 /* viscous.c */
 void fluid_laplacian_add(const fluid_t *f, int c, const double *u, double scale, double *out);
 void fluid_wall_terms_add(const fluid_t *f, int c, double scale, double *out);

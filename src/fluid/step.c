@@ -291,25 +291,58 @@ static void helmholtz_component(fluid_t *f, int c, double adt, const double *u_p
     if (fail) warn("step %ld: the Helmholtz solve of component %c did not converge\n", f->step, "uvw"[c]);
 }
 
+/* The plane hook inside the predictor sweep (fluid_ahead_t of the sweep's
+ * `done`): the stage's u* arrays are passed, they become f->u only after
+ * the sweep. */
+typedef struct {
+    fluid_t *f;
+    double *const *us;
+    int stage;
+    double adt;
+} plane_hook_call_t;
+
+static void plane_hook_at(void *ctx, int i)
+{
+    plane_hook_call_t *c = ctx;
+    c->f->plane_hook(c->f, c->us, c->stage, c->adt, i, c->f->hook_ctx);
+}
+
 void fluid_step(fluid_t *f, double dt)
 {
     const grid_t *g = f->g;
     fluid_priv_t *q = fluid_priv(f);
     int nc = fluid_ncomp(g);
     double stats[2] = {0.0, 0.0}, div_cfl[2] = {0.0, 0.0};
-    /* Fused divergence (theory §1, step 1.1): D u* computed in the predictor sweep
-     * unless something changes u* between the sweep and the projection (the
-     * immersed-boundary hook, the Crank–Nicolson solves), 3-D only. */
-    int is3d = g->dim == 3, impl = f->prm.implicit_viscous, fuse_div = is3d && !impl && !f->stage_hook;
-    /* Deferred correction (theory §1, step 1.5): the correction of stages 1
-     * and 2 done inside the next predictor sweep, when nothing reads u^k in
-     * between (no stage-end hook) and the sweep is the fused one. */
-    int defer = fuse_div && !f->stage_end_hook;
+    int is3d = g->dim == 3, impl = f->prm.implicit_viscous;
+    /* Decided after the stage-begin hook of stage 0 (its promises,
+     * f->hook_flags, hold for the step):
+     * - plane hook inside the predictor sweep (theory §1, step 1.1b) when
+     *   nothing changes u* after the sweep: 3-D, explicit, no quadratic wall
+     *   ghost (whose terms the sweep adds afterwards);
+     * - fused divergence (step 1.1): D u* computed in the predictor sweep
+     *   unless something changes u* between the sweep and the projection (a
+     *   stage hook that changes u*, a plane hook outside the sweep, the
+     *   Crank–Nicolson solves), 3-D only;
+     * - deferred correction (step 1.5): the correction of stages 1 and 2
+     *   done inside the next predictor sweep, when nothing reads u^k in
+     *   between (no stage-end hook, or one that promised not to) and the
+     *   sweep is the fused one. */
+    int fuse_plane = 0, fuse_div = 0, defer = 0;
     deferred_correction_t dc = {.f = f};
     fluid_ahead_t ahead = {deferred_ahead, &dc};
+    plane_hook_call_t phc = {.f = f};
+    fluid_ahead_t done = {plane_hook_at, &phc};
     int pending = 0;
     for (int s = 0; s < 3; s++) {
         double adt = (fluid_rk_gamma[s] + fluid_rk_zeta[s]) * dt;
+        if (f->stage_begin_hook) f->stage_begin_hook(f, s, adt, f->hook_ctx);
+        if (s == 0) {
+            int keeps = !f->stage_hook || (f->hook_flags & FLUID_HOOK_KEEPS_USTAR);
+            fuse_plane = f->plane_hook && is3d && !impl && !q->wq_any;
+            fuse_div = is3d && !impl && keeps && (!f->plane_hook || fuse_plane);
+            defer = fuse_div && (!f->stage_end_hook || (f->hook_flags & FLUID_HOOK_IDLE_UK));
+            if (f->prm.unfused) fuse_plane = fuse_div = defer = 0;
+        }
         /* H^k = −∇·(u⊗u) [+ νLu] from u^{k−1} (its ghosts are valid: every
          * stage ends with them) into spare, and the predictor
          * u* = u^{k−1} + Δt(γH^k + ζH^{k−1}) + αΔt(f − G p) [+ αΔtν/2 L u^{k−1}]
@@ -318,9 +351,12 @@ void fluid_step(fluid_t *f, double dt)
          * not needed (ζ_1 = 0: the first stage of the next step does not
          * read H_old), so it is not stored. */
         if (pending) deferred_start(&dc);
+        phc.us = q->h;
+        phc.stage = s;
+        phc.adt = adt;
         fluid_rhs_predict_div(f, -1.0, impl ? 0.0 : f->prm.nu, dt * fluid_rk_gamma[s], dt * fluid_rk_zeta[s], adt,
                               impl ? 0.5 * adt * f->prm.nu : 0.0, s < 2 ? q->spare : NULL, q->h, 1.0 / adt,
-                              fuse_div ? q->work : NULL, pending ? &ahead : NULL);
+                              fuse_div ? q->work : NULL, pending ? &ahead : NULL, fuse_plane ? &done : NULL);
         pending = 0;
         for (int c = 0; c < nc; c++) {
             double *old = f->u[c];
@@ -330,11 +366,13 @@ void fluid_step(fluid_t *f, double dt)
         }
         if (impl)
             for (int c = 0; c < nc; c++) helmholtz_component(f, c, adt, q->spare[c] /* u^{k−1} */);
+        if (f->plane_hook && !fuse_plane)
+            for (int i = 0; i < g->nxl; i++) f->plane_hook(f, f->u, s, adt, i, f->hook_ctx);
         fluid_apply_bc(f);
         if (fuse_div) fluid_divergence_rest(f, 1.0 / adt, q->work);
         if (f->stage_hook) {
             f->stage_hook(f, s, adt, f->hook_ctx);
-            fluid_apply_bc(f);
+            if (!(f->hook_flags & FLUID_HOOK_KEEPS_USTAR)) fluid_apply_bc(f);
         }
         if (defer && s < 2) {
             /* where the solver allows it, φ itself is written plane by plane inside the next sweep */

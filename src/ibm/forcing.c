@@ -3,13 +3,17 @@
  *
  * Stage k (Δt_k = (γ_k + ζ_k) Δt), fluid hooks of fluid.h:
  *
- *  before the projection (ibm_stage_force), on the predicted velocity u*:
+ *  before the predictor sweep (ibm_stage_begin): at the first stage the
+ *  moves made between steps (carry_external_moves, on u^n), then the
+ *  targets U;
+ *  on each plane of the predicted velocity u* (ibm_force_plane, the fluid's
+ *  plane hook: inside its sweep, while the plane is in cache, where it can):
  *     u* ← u* + α (U − u*)         at every node with α > 0,
  *  U the rigid-body velocity u_p + ω_p × r of the sphere at the start of the
  *  stage, i.e. f = α (U − u*)/Δt_k.  Overlapping spheres: α = min(1, Σ α_p)
  *  and U the α-weighted mean of their velocities; sphere p takes the share
  *  α_p/Σα_p of the node's impulse.  With forcing_iterations = N the pair
- *  (force, project) is done N extra times before the final forcing.
+ *  (project, force) follows N times (ibm_stage_force, after the sweep).
  *
  *  after the projection (ibm_stage_end), on u^k: each sphere's solid
  *  fraction is moved to the explicit prediction X^k = x^{k−1} + Δt_k u^{k−1}
@@ -124,20 +128,25 @@ static void set_targets(ibm_t *ibm)
     ibm_targets_of(ibm, 0, q->nruns, 0, q->nnodes);
 }
 
-/* One forcing u ← u + β (Ū − u) of every forced node, the impulse added
- * to node_imp (stored by the first forcing after set_targets). */
-static void force_nodes(ibm_t *ibm, double dt)
+/* One forcing u ← u + β (Ū − u) of the forced nodes of the node runs
+ * r0 .. r1−1 (u[c]: the velocity arrays to force), the impulse added to
+ * node_imp (stored, not added, when `first`: the first forcing after
+ * set_targets). */
+static void force_node_runs(ibm_t *ibm, double *const u_of[3], long r0, long r1, double dt, int first)
 {
     const grid_t *g = ibm->g;
     ibm_priv_t *q = ibm_priv(ibm);
     double kappa = ibm->prm.forcing_time, nu = ibm->f->prm.nu;
     long st = q->rstride;
-    int fast = kappa <= 0 && st == 1, first = q->imp_fresh;
-    q->imp_fresh = 0;
-    if (first && !fast && q->nnodes > 0) memset(q->node_imp, 0, (size_t)q->nnodes * sizeof(double)); /* none on this rank: NULL */
-    for (long ir = 0; ir < q->n_nruns; ir++) {
+    int fast = kappa <= 0 && st == 1;
+    if (r1 <= r0) return;
+    if (first && !fast) {
+        long n0 = q->nruns_f[r0].n0, n1 = q->nruns_f[r1 - 1].n0 + q->nruns_f[r1 - 1].len;
+        memset(q->node_imp + n0, 0, (size_t)(n1 - n0) * sizeof(double));
+    }
+    for (long ir = r0; ir < r1; ir++) {
         const ibm_node_run_t *nr = &q->nruns_f[ir];
-        double *u = ibm->f->u[nr->c] + nr->m0, *J = q->node_imp + nr->n0;
+        double *u = u_of[nr->c] + nr->m0, *J = q->node_imp + nr->n0;
         const double *A = q->node_asum + nr->n0, *T = q->node_target + nr->n0;
         int len = nr->len;
         if (fast) { /* the seed's β = α, unit stride: vectorised; the
@@ -169,6 +178,37 @@ static void force_nodes(ibm_t *ibm, double dt)
             }
         }
     }
+}
+
+/* The node runs of each (component c, local x plane i): plane_nrun[c (nxl
+ * + 1) + i] .. plane_nrun[c (nxl + 1) + i + 1] − 1 (the build appends them
+ * by component, then by plane), found by bisection after each build. */
+static void index_planes(ibm_t *ibm)
+{
+    const grid_t *g = ibm->g;
+    ibm_priv_t *q = ibm_priv(ibm);
+    long np = (long)g->nxl + 1;
+    ibm->nodes_distinct = q->nnodes;
+    for (int c = 0; c < g->dim; c++)
+        for (int i = 0; i <= g->nxl; i++) {
+            /* first node run whose (component, plane) is not below (c, i) */
+            long lo = 0, hi = q->n_nruns, key = c * np + i;
+            while (lo < hi) {
+                long mid = (lo + hi) / 2;
+                const ibm_node_run_t *nr = &q->nruns_f[mid];
+                if (nr->c * np + ibm_node_i(g, nr->m0) < key)
+                    lo = mid + 1;
+                else
+                    hi = mid;
+            }
+            q->plane_nrun[c * np + i] = lo;
+        }
+}
+
+/* Every forced node once (the forcing iterations). */
+static void force_nodes(ibm_t *ibm, double dt)
+{
+    force_node_runs(ibm, ibm->f->u, 0, ibm_priv(ibm)->n_nruns, dt, 0);
 }
 
 /* Per-sphere sums over the runs (in storage order, each sphere's sums
@@ -285,6 +325,16 @@ static void displacement(const grid_t *g, const double a[3], const double b[3], 
  * where it was put over the three stages. */
 static inline int still_within_step(const ibm_sphere_t *s) { return s->kind == IBM_FIXED || s->kind == IBM_EXTERNAL; }
 
+/* Is the solid fraction of sphere s held where the step started over its
+ * three stages?  Fixed and external spheres, and free ones with
+ * free_alpha = step: those move (x, u, ω change at every stage) but their α
+ * is moved between steps, like an external sphere's, with the whole jump
+ * counted (xpred = x: λ = 1 in carry_external_moves). */
+static inline int alpha_held(const ibm_t *ibm, const ibm_sphere_t *s)
+{
+    return still_within_step(s) || (s->kind == IBM_FREE && ibm->prm.free_alpha_per_step);
+}
+
 /* Do all spheres keep their position and velocity over the fluid step
  * (fixed spheres, and external ones, which the coupling moves between
  * steps)?  Then the solid fraction and the targets Ū stay as they are over
@@ -321,7 +371,7 @@ static int carry_external_moves(ibm_t *ibm)
     char *mv = xcalloc((size_t)ibm->n, 1);
     for (int p = 0; p < ibm->n; p++) {
         ibm_sphere_t *s = &ibm->s[p];
-        if (!still_within_step(s) || !memcmp(s->xa, s->x, sizeof s->x)) continue;
+        if (!alpha_held(ibm, s) || !memcmp(s->xa, s->x, sizeof s->x)) continue;
         double dx[3], dp[3], *I = q->mom_prev + 6 * p, *L = I + 3, dd = 0, dpd = 0;
         displacement(ibm->g, s->xa, s->x, dx);
         displacement(ibm->g, s->xa, s->xpred, dp);
@@ -375,33 +425,73 @@ void ibm_update_geometry(ibm_t *ibm)
     for (int p = 0; p < ibm->n; p++) memcpy(ibm->s[p].xa, ibm->s[p].x, sizeof ibm->s[p].x);
     ibm_rebuild_geometry(ibm);
     for (int p = 0; p < ibm->n; p++)
-        if (still_within_step(&ibm->s[p]))
+        if (alpha_held(ibm, &ibm->s[p]))
             memcpy(q->mom_prev + 6 * p, keep + 6 * p, 6 * sizeof(double));
     free(keep);
 }
 
-void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
+/* Before the predictor sweep of a stage: the moves made since the last step
+ * (stage 0), the targets Ū, and the promises to the fluid (fluid.h): the
+ * stage hook below only reads u* unless there are forcing iterations, and
+ * in a step where nothing moves (frozen) the stage-end hook of stages 0 and
+ * 1 reads nothing, so the fluid may fuse the forcing, the divergence and
+ * the correction into its sweeps (docs/theory.md §1). */
+void ibm_stage_begin(fluid_t *f, int stage, double dt_stage, void *ctx)
 {
+    (void)dt_stage;
     ibm_t *ibm = ctx;
     ibm_priv_t *q = ibm_priv(ibm);
+    double w0 = wtime();
     if (stage == 0) {
         q->t_step = 0.0;
         q->t_stage0 = f->time;
         memset(q->imp_step, 0, (size_t)ibm->n * 6 * sizeof(double));
         q->frozen = step_frozen(ibm);
         /* the moves made since the last step (ibm_update_geometry) */
-        double w0 = wtime();
-        if (q->frozen) carry_external_moves(ibm);
-        ibm->wall_alpha += wtime() - w0;
+        if (q->frozen || ibm->prm.free_alpha_per_step) carry_external_moves(ibm);
+        f->hook_flags = (ibm->prm.forcing_iterations == 0 ? FLUID_HOOK_KEEPS_USTAR : 0) |
+                        (q->frozen ? FLUID_HOOK_IDLE_UK : 0);
     }
-    double w0 = wtime();
+    double w1 = wtime();
     if (stage == 0 || !q->frozen) set_targets(ibm);
+    /* the forcing of this stage starts the accumulation of the impulses */
+    q->stage_first = q->imp_fresh;
+    q->imp_fresh = 0;
+    index_planes(ibm);
+    ibm->wall_alpha += w1 - w0;
+    ibm->wall_forcing += wtime() - w1;
+}
+
+/* Plane i of the predicted velocity (all its components): the forcing. */
+void ibm_force_plane(fluid_t *f, double *const ustar[3], int stage, double dt_stage, int i, void *ctx)
+{
+    (void)f;
+    (void)stage;
+    ibm_t *ibm = ctx;
+    ibm_priv_t *q = ibm_priv(ibm);
+    long np = (long)ibm->g->nxl + 1, any = 0;
+    for (int c = 0; c < ibm->g->dim; c++) any |= q->plane_nrun[c * np + i + 1] > q->plane_nrun[c * np + i];
+    if (!any) return; /* (most planes of a scene with few spheres: not even timed) */
+    double w0 = wtime();
+    for (int c = 0; c < ibm->g->dim; c++)
+        force_node_runs(ibm, ustar, q->plane_nrun[c * np + i], q->plane_nrun[c * np + i + 1], dt_stage,
+                        q->stage_first);
+    ibm->wall_forcing += wtime() - w0;
+}
+
+/* After the sweep (u* forced by the plane hook, ghosts filled): the extra
+ * forcing iterations, (project, force) N times, and the impulses of the
+ * stage before the solid fraction moves. */
+void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx)
+{
+    (void)stage;
+    ibm_t *ibm = ctx;
+    ibm_priv_t *q = ibm_priv(ibm);
+    double w0 = wtime();
     for (int it = 0; it < ibm->prm.forcing_iterations; it++) {
-        force_nodes(ibm, dt_stage);
         fluid_stage_project(f, dt_stage);
+        force_nodes(ibm, dt_stage);
     }
-    force_nodes(ibm, dt_stage);
-    /* the impulses of the stage, before the solid fraction moves */
     if (!q->frozen) sphere_sums(ibm, q->sum, 1, 0);
     ibm->wall_forcing += wtime() - w0;
 }
@@ -425,6 +515,7 @@ static void mask_geometry(const grid_t *g, double v[3], double w[3])
 static void predict_centre(const ibm_t *ibm, ibm_sphere_t *s, double dt, double t_end)
 {
     double u1[3], w1[3];
+    if (s->kind == IBM_FREE && ibm->prm.free_alpha_per_step) return; /* α held over the step */
     switch (s->kind) {
     case IBM_FIXED:
     case IBM_EXTERNAL: memcpy(s->xa, s->x, sizeof s->xa); return; /* moved between steps only */
@@ -469,7 +560,7 @@ static void update_sphere(ibm_t *ibm, int p, double dt, double t_end, double J[3
     memcpy(w0, s->omega, sizeof w0);
     /* the reference point of L moves with the solid fraction: not so for
      * fixed and external spheres, whose α stays where it is over the step */
-    double dt_ref = still_within_step(s) ? 0.0 : dt;
+    double dt_ref = alpha_held(ibm, s) ? 0.0 : dt;
     for (int c = 0; c < 3; c++) {
         J[c] = rho * (sum[IBM_MOM + c] - prev[c] - sum[IBM_FIMP + c]);
         K[c] = rho * (sum[IBM_ANG + c] - prev[3 + c] + dt_ref * uxI[c] - sum[IBM_TIMP + c]);
@@ -578,12 +669,17 @@ void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx)
         for (int d = 0; d < 6; d++) q->mom_prev[6 * p + d] = q->sum[(long)p * IBM_NSUM + IBM_MOM + d];
     }
     if (stage == 2)
-        for (int p = 0; p < ibm->n; p++)
+        for (int p = 0; p < ibm->n; p++) {
+            ibm_sphere_t *s = &ibm->s[p];
+            /* a free sphere whose α was held: its own motion over the step,
+             * all of it counted when α is moved (λ = 1) */
+            int own = s->kind == IBM_FREE && ibm->prm.free_alpha_per_step;
             for (int d = 0; d < 3; d++) {
-                ibm->s[p].force[d] = q->imp_step[6 * p + d] / q->t_step;
-                ibm->s[p].torque[d] = q->imp_step[6 * p + 3 + d] / q->t_step;
-                ibm->s[p].xpred[d] = ibm->s[p].xa[d] + q->t_step * ibm->s[p].u[d];
+                s->force[d] = q->imp_step[6 * p + d] / q->t_step;
+                s->torque[d] = q->imp_step[6 * p + 3 + d] / q->t_step;
+                s->xpred[d] = own ? s->x[d] : s->xa[d] + q->t_step * s->u[d];
             }
+        }
     ibm->wall_alpha += w1 - w0;
     ibm->wall_integrals += wtime() - w1;
 }

@@ -33,6 +33,11 @@ static const cfg_key_t ibm_keys[] = {
     {"ibm", "forcing_time", CFG_DOUBLE, "0", 0, 1e6, NULL,
      "κ: a node of solid fraction α < 1 is forced by u ← u + β(U − u), β = αΔt_k/((1−α)κh²/ν + αΔt_k), whose "
      "steady state does not depend on the time step; 0: the seed's β = α at every stage (depends on Δt)"},
+    {"ibm", "free_alpha", CFG_ENUM, "stage", 1, 0, "stage|step",
+     "where a free sphere's solid fraction is over a fluid step: moved to the predicted centre after every "
+     "Runge-Kutta stage (stage), or held where the step started and moved between steps, the fluid momentum "
+     "over the jump counted in the next force (step: one rebuild per step instead of three, see "
+     "docs/theory.md)"},
     {"ibm", "retraction", CFG_DOUBLE, "0", -1, 1, NULL,
      "the solid fraction is that of a sphere of radius R - retraction × Δx (cells): compensates the effective "
      "thickening of the forced sphere (0: the seed's method)"},
@@ -167,7 +172,8 @@ static const char *sphere_misfit(const grid_t *g, const ibm_sphere_t *s)
 ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, int n)
 {
     const grid_t *g = f->g;
-    if (f->stage_hook || f->stage_end_hook) die("immersed boundary: the fluid's stage hooks are already in use");
+    if (f->stage_begin_hook || f->plane_hook || f->stage_hook || f->stage_end_hook)
+        die("immersed boundary: the fluid's stage hooks are already in use");
     if (g->nalloc >= INT32_MAX) die("immersed boundary: a field of %ld values is too large for the node lists", g->nalloc);
     for (int d = 0; d < g->dim; d++)
         if (g->periodic[d] && g->n[d] > 127 * 1000000) die("immersed boundary: grid too large");
@@ -210,9 +216,13 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
     q->mom_prev = xcalloc(nn * 6, sizeof(double));
     q->target_vel = xcalloc(nn * 6, sizeof(double));
     q->imp_step = xcalloc(nn * 6, sizeof(double));
+    q->plane_nrun = xcalloc((size_t)g->dim * ((size_t)g->nxl + 1), sizeof *q->plane_nrun);
+    f->stage_begin_hook = ibm_stage_begin;
+    f->plane_hook = ibm_force_plane;
     f->stage_hook = ibm_stage_force;
     f->stage_end_hook = ibm_stage_end;
     f->hook_ctx = ibm;
+    f->hook_flags = 0;
     ibm_update_geometry(ibm);
     return ibm;
 }
@@ -222,9 +232,12 @@ void ibm_free(ibm_t *ibm)
     if (!ibm) return;
     ibm_priv_t *q = ibm_priv(ibm);
     if (ibm->f->hook_ctx == ibm) {
+        ibm->f->stage_begin_hook = NULL;
+        ibm->f->plane_hook = NULL;
         ibm->f->stage_hook = NULL;
         ibm->f->stage_end_hook = NULL;
         ibm->f->hook_ctx = NULL;
+        ibm->f->hook_flags = 0;
     }
     for (int c = 0; c < 3; c++) {
         if (q->vol[c]) free(q->vol[c] - 1);
@@ -249,6 +262,7 @@ void ibm_free(ibm_t *ibm)
     free(q->mom_prev);
     free(q->target_vel);
     free(q->imp_step);
+    free(q->plane_nrun);
     free(q);
     free(ibm->s);
     free(ibm);
@@ -485,6 +499,7 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
     cfg_vec3(cfg, "ibm", "gravity", prm.gravity);
     prm.retraction = cfg_double(cfg, "ibm", "retraction");
     prm.forcing_time = cfg_double(cfg, "ibm", "forcing_time");
+    prm.free_alpha_per_step = cfg_enum(cfg, "ibm", "free_alpha");
     if (g->geom == GEOM_AXI && (prm.gravity[0] != 0.0 || prm.gravity[2] != 0.0))
         cfg_fail(cfg, "ibm", "gravity", "an axisymmetric gravity must be axial (y)");
     if (g->dim == 2 && prm.gravity[2] != 0.0) cfg_fail(cfg, "ibm", "gravity", "a 2-D grid has no z direction");

@@ -75,6 +75,8 @@ typedef struct {
     int targets_valid; /* node_target was set from these node lists and the velocities in target_vel */
     double *target_vel; /* n × 6: u, ω of each sphere when node_target was set */
     int frozen;        /* this step: no sphere moves within it (forcing.c) */
+    int stage_first;   /* the forcing of this stage stores the impulses (forcing.c) */
+    long *plane_nrun;  /* dim × (nxl + 1): first node run of each (component, local x plane) (forcing.c) */
     /* control volume of each unknown by local x index (−1..nxl), times 2π
      * in axisymmetric geometry: the integrals are over the whole volume */
     double *vol[3];
@@ -120,6 +122,8 @@ void ibm_sums_of(ibm_t *ibm, double *sum_all, long r0, long r1, int impulses, in
  * cover them, from the spheres' velocities recorded by ibm_targets_note(). */
 void ibm_targets_note(ibm_t *ibm);
 void ibm_targets_of(ibm_t *ibm, long r0, long r1, long n0, long n1);
+void ibm_stage_begin(fluid_t *f, int stage, double dt_stage, void *ctx);
+void ibm_force_plane(fluid_t *f, double *const ustar[3], int stage, double dt_stage, int i, void *ctx);
 void ibm_stage_force(fluid_t *f, int stage, double dt_stage, void *ctx);
 void ibm_stage_end(fluid_t *f, int stage, double dt_stage, void *ctx);
 
