@@ -468,18 +468,18 @@ static void plane_alpha(ibm_t *ibm, long r0, long r1, long n0, long n1)
         grow((void **)&q->node_imp, &cap3, n1, sizeof(double), "nodes");
         q->cap_nodes = cap;
     }
-    /* scratch: the forced node of each entry (in order[]), the number of
+    /* scratch: the forced node of each entry (in entry_node[]), the number of
      * spheres at each node (cnt[]) */
-    grow((void **)&q->order, &q->cap_order, n + RUN_SHORT, sizeof *q->order, "nodes");
+    grow((void **)&q->entry_node, &q->cap_entry_node, n + RUN_SHORT, sizeof *q->entry_node, "nodes");
     grow((void **)&q->cnt, &q->cap_cnt, nn, sizeof *q->cnt, "nodes");
     const double *al = q->alpha + q->nalpha;
     /* the cell size h is that of the plane */
     alpha_runs(ibm, q->runs + r0, r1 - r0, q->hcell[q->runs[r0].c][ibm_node_i(g, q->runs[r0].m0)], n0, q->nalpha,
-               q->alpha + q->nalpha, q->order);
+               q->alpha + q->nalpha, q->entry_node);
     q->nalpha += n;
     double *restrict A = q->node_asum + n0;
     int32_t *restrict cnt = q->cnt;
-    const int32_t *restrict nid = q->order;
+    const int32_t *restrict nid = q->entry_node;
     memset(A, 0, (size_t)nn * sizeof *A);
     memset(cnt, 0, (size_t)nn * sizeof *cnt);
     for (long e = 0; e < n; e++) {

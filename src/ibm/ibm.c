@@ -255,7 +255,7 @@ void ibm_free(ibm_t *ibm)
     free(q->node_target);
     free(q->node_imp);
     free(q->line_head);
-    free(q->order);
+    free(q->entry_node);
     free(q->tmp);
     free(q->cnt);
     free(q->sum);

@@ -64,12 +64,12 @@ typedef struct {
     long nnodes, cap_nodes;
     /* scratch of the build, one plane at a time (alpha.c): the runs as
      * generated, the first of each grid line's runs among the sorted ones,
-     * the forced node of each node entry (order) and the number of spheres
+     * the forced node of each node entry (entry_node) and the number of spheres
      * at each node (cnt) */
     ibm_run_t *tmp;
     long ntmp, cap_tmp;
-    int32_t *order, *line_head, *cnt;
-    long cap_order, cap_cnt;
+    int32_t *entry_node, *line_head, *cnt;
+    long cap_entry_node, cap_cnt;
     int built;         /* node lists exist */
     int imp_fresh;     /* node_imp is to be restarted by the next forcing */
     int targets_valid; /* node_target was set from these node lists and the velocities in target_vel */
