@@ -8,7 +8,9 @@
  *   u*    = u^{k−1} + Δt (γ_k H^k + ζ_k H^{k−1}) + α_k Δt (f − G p^{k−1})
  *           [+ α_k Δt ν/2 (L u^{k−1} + L u*) when Crank–Nicolson: the Helmholtz
  *            problem (L − λ) u* = −λ rhs − (wall terms), λ = 2/(α_k Δt ν)]
- *   stage hook (immersed boundary) on u*
+ *   hooks of a particle module (the immersed boundary): stage begin before
+ *   the predictor; the plane hook on each plane of u* (inside the predictor
+ *   sweep where it can be); the stage hook on u*
  *   L φ   = D u* / (α_k Δt),   u^k = u* − α_k Δt G φ,
  *   p^k   = p^{k−1} + φ  [− α_k Δt ν/2 L φ when Crank–Nicolson],
  *   stage-end hook (immersed boundary: particle update) on u^k.
@@ -101,10 +103,6 @@ static void correct_velocity(fluid_t *f, const double *restrict ph, double dt_st
     }
 }
 
-/* The projection of a stage.  div_ready: q->work already holds D(u*)/(αΔt)
- * (the fused sweep of fluid_step).  div_cfl (3-D, or NULL): receives this
- * rank's max |D u^k| and convective rate, computed in the correction sweep
- * and completed after the ghost fill. */
 /* The pressure correction φ of a stage into q->work, ghosts filled:
  * L φ = D(u*)/(αΔt), solved in place (div_ready: q->work already holds the
  * right-hand side).  With `by_planes` the solve stops before writing φ,
@@ -125,6 +123,10 @@ static double *solve_correction(fluid_t *f, double dt_stage, int div_ready, int 
     return phi;
 }
 
+/* The projection of a stage.  div_ready: q->work already holds D(u*)/(αΔt)
+ * (the fused sweep of fluid_step).  div_cfl (3-D, or NULL): receives this
+ * rank's max |D u^k| and convective rate, computed in the correction sweep
+ * and completed after the ghost fill. */
 static void project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats, int div_ready,
                           double *div_cfl)
 {
