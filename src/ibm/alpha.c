@@ -502,6 +502,31 @@ static int by_run_coordinate(const void *a, const void *b)
     return i->z < j->z ? -1 : i->z > j->z ? 1 : (i->p > j->p) - (i->p < j->p);
 }
 
+/* The node runs of each (component c, local x plane i): plane_nrun[c (nxl
+ * + 1) + i] .. plane_nrun[c (nxl + 1) + i + 1] − 1 (the build appends them
+ * by component, then by plane), found by bisection at the end of each build (the plane hook forces a
+ * plane's node runs). */
+static void index_planes(ibm_t *ibm)
+{
+    const grid_t *g = ibm->g;
+    ibm_priv_t *q = ibm_priv(ibm);
+    long np = (long)g->nxl + 1;
+    for (int c = 0; c < g->dim; c++)
+        for (int i = 0; i <= g->nxl; i++) {
+            /* first node run whose (component, plane) is not below (c, i) */
+            long lo = 0, hi = q->n_nruns, key = c * np + i;
+            while (lo < hi) {
+                long mid = (lo + hi) / 2;
+                const ibm_node_run_t *nr = &q->nruns_f[mid];
+                if (nr->c * np + ibm_node_i(g, nr->m0) < key)
+                    lo = mid + 1;
+                else
+                    hi = mid;
+            }
+            q->plane_nrun[c * np + i] = lo;
+        }
+}
+
 /* The node lists, plane by plane (component c, local x index i) in
  * storage order: the spheres whose box reaches the plane generate their
  * runs there, which are sorted, merged and given their α, and, while they
@@ -576,7 +601,9 @@ void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
     q->built = 1;
     q->targets_valid = targets;
     ibm->nodes_forced = q->nalpha;
+    ibm->nodes_distinct = q->nnodes;
     ibm->nodes_shared = q->nshared;
+    index_planes(ibm);
 }
 
 /* ---- solid fraction fields --------------------------------------------------------- */

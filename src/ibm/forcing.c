@@ -117,7 +117,7 @@ void ibm_targets_of(ibm_t *ibm, long r0, long r1, long n0, long n1)
 static void set_targets(ibm_t *ibm)
 {
     ibm_priv_t *q = ibm_priv(ibm);
-    q->imp_fresh = 1; /* the next forcing starts the accumulation */
+    q->stage_first = 1; /* this stage's forcing starts the accumulation */
     int same = q->targets_valid;
     for (int p = 0; p < ibm->n && same; p++)
         same = !memcmp(q->target_vel + 6 * p, ibm->s[p].u, 3 * sizeof(double)) &&
@@ -178,31 +178,6 @@ static void force_node_runs(ibm_t *ibm, double *const u_of[3], long r0, long r1,
             }
         }
     }
-}
-
-/* The node runs of each (component c, local x plane i): plane_nrun[c (nxl
- * + 1) + i] .. plane_nrun[c (nxl + 1) + i + 1] − 1 (the build appends them
- * by component, then by plane), found by bisection after each build. */
-static void index_planes(ibm_t *ibm)
-{
-    const grid_t *g = ibm->g;
-    ibm_priv_t *q = ibm_priv(ibm);
-    long np = (long)g->nxl + 1;
-    ibm->nodes_distinct = q->nnodes;
-    for (int c = 0; c < g->dim; c++)
-        for (int i = 0; i <= g->nxl; i++) {
-            /* first node run whose (component, plane) is not below (c, i) */
-            long lo = 0, hi = q->n_nruns, key = c * np + i;
-            while (lo < hi) {
-                long mid = (lo + hi) / 2;
-                const ibm_node_run_t *nr = &q->nruns_f[mid];
-                if (nr->c * np + ibm_node_i(g, nr->m0) < key)
-                    lo = mid + 1;
-                else
-                    hi = mid;
-            }
-            q->plane_nrun[c * np + i] = lo;
-        }
 }
 
 /* Every forced node once (the forcing iterations). */
@@ -453,11 +428,9 @@ void ibm_stage_begin(fluid_t *f, int stage, double dt_stage, void *ctx)
                         (q->frozen ? FLUID_HOOK_IDLE_UK : 0);
     }
     double w1 = wtime();
+    /* the impulses accumulate over the stages until the targets are set again */
+    q->stage_first = 0;
     if (stage == 0 || !q->frozen) set_targets(ibm);
-    /* the forcing of this stage starts the accumulation of the impulses */
-    q->stage_first = q->imp_fresh;
-    q->imp_fresh = 0;
-    index_planes(ibm);
     ibm->wall_alpha += w1 - w0;
     ibm->wall_forcing += wtime() - w1;
 }

@@ -71,12 +71,11 @@ typedef struct {
     int32_t *entry_node, *line_head, *cnt;
     long cap_entry_node, cap_cnt;
     int built;         /* node lists exist */
-    int imp_fresh;     /* node_imp is to be restarted by the next forcing */
     int targets_valid; /* node_target was set from these node lists and the velocities in target_vel */
     double *target_vel; /* n × 6: u, ω of each sphere when node_target was set */
     int frozen;        /* this step: no sphere moves within it (forcing.c) */
-    int stage_first;   /* the forcing of this stage stores the impulses (forcing.c) */
-    long *plane_nrun;  /* dim × (nxl + 1): first node run of each (component, local x plane) (forcing.c) */
+    int stage_first;   /* this stage's forcing stores the impulses, not adds them (set_targets) */
+    long *plane_nrun;  /* dim × (nxl + 1): first node run of each (component, local x plane) */
     /* control volume of each unknown by local x index (−1..nxl), times 2π
      * in axisymmetric geometry: the integrals are over the whole volume */
     double *vol[3];
