@@ -4,16 +4,16 @@
  *
  * Scene: a triply periodic box of N³ cells, Δx = D/dpd, with `count`
  * spheres placed at random without overlap (random sequential addition,
- * fixed seed).  The fluid alone is timed over `steps` steps, then the same
- * steps with the spheres, in three variants (one warm-up step each); the
- * best step of each (least disturbed on a shared machine) is reported:
+ * fixed seed).  Four variants of the spheres (one warm-up step each), each
+ * timed over `steps` steps; the best step (least disturbed on a shared
+ * machine) is reported:
  *   external_moving  external spheres (the DEM-coupled kind) moved by
  *                    0.01 Δx along a random direction before every step,
  *                    with the matching velocity, ibm_update_geometry() —
  *                    the realistic case: α rebuilt once per step;
  *   external_rest    external spheres at rest (α built once);
  *   free             free spheres (ρ_p/ρ = 2 under gravity): α rebuilt
- *                    after every stage.
+ *                    after every stage;
  *   free_step        the same with [ibm] free_alpha = step: α held over the
  *                    step, rebuilt once per step.
  * Every repetition times one step of the fluid alone (the immersed
@@ -30,9 +30,11 @@
  *
  * usage: bench_ibm [N=128] [count=1000] [dpd=10] [steps=5] [explicit|implicit] [variant]
  * (variant: run only that one, e.g. for a profile)
- * prints, per variant: the fluid step with the spheres, the immersed
- * boundary's time per step (α, forcing, integrals), its fraction of the
- * fluid step alone, node entries per sphere; and one ibm_result line each.
+ * prints, per variant: the fluid step alone and with the spheres, their
+ * difference as a fraction of the step alone (the cost; `fraction=` of the
+ * ibm_result line), the immersed boundary's timers (α, forcing, integrals;
+ * `timers_fraction=`), node entries per sphere; then the floor, and one
+ * ibm_result line each.
  */
 #include <math.h>
 #include <stdio.h>
