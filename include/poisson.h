@@ -109,6 +109,10 @@ int poisson_solve(poisson_t *p, double lambda, const double *b, double *x);
 int poisson_solve_by_planes(const poisson_t *p);
 void poisson_solve_begin(poisson_t *p, double lambda, const double *b);
 void poisson_solve_plane(poisson_t *p, double *x, int i);
+/* The forward transform of plane i of b done ahead of the solve (same
+ * availability), by the writer of b once that plane is final: the next
+ * solve with that b skips it.  Bit-identical. */
+void poisson_forward_plane(poisson_t *p, const double *b, int i);
 
 /* y = (L − λI) x on the interior unknowns.  Fills the ghosts of x first
  * (halo exchange + homogeneous BC), so x is modified in its ghosts only. */

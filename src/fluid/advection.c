@@ -196,7 +196,8 @@ static void line_coefs(const fluid_t *f, int c, int i, double adt, coef_t *k)
  * US[c] (= H_old on entry, read only when st->dz ≠ 0).  Ghosts of u must be
  * valid. */
 static void rhs_sweep(const fluid_t *f, const stage_t *st, double adt, double *const H[3], double *const US[3],
-                      double div_scale, double *div, const fluid_ahead_t *ahead, const fluid_ahead_t *done)
+                      double div_scale, double *div, const fluid_ahead_t *ahead, const fluid_ahead_t *done,
+                      const fluid_ahead_t *after_div)
 {
     const grid_t *g = f->g;
     const double *u = f->u[0], *v = f->u[1], *w = g->dim == 3 ? f->u[2] : NULL;
@@ -235,6 +236,7 @@ static void rhs_sweep(const fluid_t *f, const stage_t *st, double adt, double *c
          * divergence while it is in cache */
         if (done) done->fn(done->ctx, i);
         if (div) fluid_divergence_interior_plane(f, (const double *const *)US, div_scale, div, i);
+        if (after_div) after_div->fn(after_div->ctx, i);
     }
 }
 
@@ -253,22 +255,22 @@ static void wall_ghost_terms(const fluid_t *f, double cv, double dg, double ce, 
 void fluid_rhs(const fluid_t *f, double ca, double cv, double *const out[3])
 {
     stage_t st = {.ca = ca, .cv = cv, .p = f->p};
-    rhs_sweep(f, &st, 0.0, out, NULL, 0.0, NULL, NULL, NULL);
+    rhs_sweep(f, &st, 0.0, out, NULL, 0.0, NULL, NULL, NULL, NULL);
     wall_ghost_terms(f, cv, 0.0, 0.0, out, NULL);
 }
 
 void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
                        double *const H[3], double *const US[3])
 {
-    fluid_rhs_predict_div(f, ca, cv, dg, dz, adt, ce, H, US, 0.0, NULL, NULL, NULL);
+    fluid_rhs_predict_div(f, ca, cv, dg, dz, adt, ce, H, US, 0.0, NULL, NULL, NULL, NULL);
 }
 
 void fluid_rhs_predict_div(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
                            double *const H[3], double *const US[3], double div_scale, double *div,
-                           const fluid_ahead_t *ahead, const fluid_ahead_t *done)
+                           const fluid_ahead_t *ahead, const fluid_ahead_t *done, const fluid_ahead_t *after_div)
 {
     stage_t st = {.ca = ca, .cv = cv, .dg = dg, .dz = dz, .ce = ce, .p = f->p};
-    rhs_sweep(f, &st, adt, H, US, div_scale, f->g->dim == 3 ? div : NULL, ahead, done);
+    rhs_sweep(f, &st, adt, H, US, div_scale, f->g->dim == 3 ? div : NULL, ahead, done, after_div);
     /* the wall terms change u* next to walls only: cells fluid_interior leaves out */
     wall_ghost_terms(f, cv, dg, ce, H, US);
 }

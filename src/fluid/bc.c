@@ -154,13 +154,15 @@ void fluid_apply_bc_edges(fluid_t *f)
     }
 }
 
-void fluid_apply_bc_plane(fluid_t *f, int i)
+void fluid_apply_bc_plane_of(const fluid_t *f, double *const u[3], int i)
 {
     for (int c = 0; c < fluid_ncomp(f->g); c++) {
-        grid_halo_yz_planes(f->g, f->u[c], i, i);
-        fill_yz_face_ghosts(f, c, f->u[c], i, i);
+        grid_halo_yz_planes(f->g, u[c], i, i);
+        fill_yz_face_ghosts(f, c, u[c], i, i);
     }
 }
+
+void fluid_apply_bc_plane(fluid_t *f, int i) { fluid_apply_bc_plane_of(f, f->u, i); }
 
 /* The pressure (and its correction φ) has zero normal gradient at walls and
  * on the axis: the ghosts of the VAR_P operator. */

@@ -102,21 +102,26 @@ static void split_interior_plane(const fluid_t *f, const split_pass_t *sp, int i
     if (i >= b.ilo && i < b.ihi) split_block(f, sp, i, b.jlo, b.jhi, b.klo, b.khi);
 }
 
-/* every cell outside the interior */
-static void split_rest(const fluid_t *f, const split_pass_t *sp)
+/* the cells of interior plane i (ilo ≤ i < ihi) outside the interior */
+static void split_rest_plane(const fluid_t *f, const split_pass_t *sp, const fluid_interior_t *b, int i)
+{
+    int ny = f->g->n[1], nz = f->g->n[2];
+    split_block(f, sp, i, 0, b->jlo, 0, nz);
+    split_block(f, sp, i, b->jhi, ny, 0, nz);
+    split_block(f, sp, i, b->jlo, b->jhi, 0, b->klo);
+    split_block(f, sp, i, b->jlo, b->jhi, b->khi, nz);
+}
+
+/* every cell outside the interior (edges_only: those of the planes outside
+ * [ilo, ihi) only, the others' done by split_rest_plane) */
+static void split_rest(const fluid_t *f, const split_pass_t *sp, int edges_only)
 {
     const grid_t *g = f->g;
     fluid_interior_t b = fluid_interior(g);
     int ny = g->n[1], nz = g->n[2];
     for (int i = 0; i < g->nxl; i++) {
-        if (i < b.ilo || i >= b.ihi) {
-            split_block(f, sp, i, 0, ny, 0, nz);
-            continue;
-        }
-        split_block(f, sp, i, 0, b.jlo, 0, nz);
-        split_block(f, sp, i, b.jhi, ny, 0, nz);
-        split_block(f, sp, i, b.jlo, b.jhi, 0, b.klo);
-        split_block(f, sp, i, b.jlo, b.jhi, b.khi, nz);
+        if (i < b.ilo || i >= b.ihi) split_block(f, sp, i, 0, ny, 0, nz);
+        else if (!edges_only) split_rest_plane(f, sp, &b, i);
     }
 }
 
@@ -130,10 +135,28 @@ void fluid_divergence_interior_plane(const fluid_t *f, const double *const uu[3]
     split_interior_plane(f, &(split_pass_t){.uu = uu, .scale = scale, .div = div}, i);
 }
 
-void fluid_divergence_rest(const fluid_t *f, double scale, double *div)
+void fluid_divergence_rest(const fluid_t *f, double scale, double *div, int edges_only)
 {
     const double *uu[3] = {f->u[0], f->u[1], f->u[2]};
-    split_rest(f, &(split_pass_t){.uu = uu, .scale = scale, .div = div});
+    split_rest(f, &(split_pass_t){.uu = uu, .scale = scale, .div = div}, edges_only);
+}
+
+/* The planes whose every cell the sweep can complete (ilo ≤ i < ihi). */
+void fluid_interior_planes(const grid_t *g, int *ilo, int *ihi)
+{
+    fluid_interior_t b = fluid_interior(g);
+    *ilo = b.ilo;
+    *ihi = b.ihi;
+}
+
+/* The cells of interior plane i that fluid_divergence_interior_plane leaves
+ * (next to a y or z face), once the ghosts of plane i of uu are filled: the
+ * plane's divergence complete inside the sweep (a plane of the edges is
+ * left to fluid_divergence_rest with edges_only). */
+void fluid_divergence_rest_plane(const fluid_t *f, const double *const uu[3], double scale, double *div, int i)
+{
+    fluid_interior_t b = fluid_interior(f->g);
+    if (i >= b.ilo && i < b.ihi) split_rest_plane(f, &(split_pass_t){.uu = uu, .scale = scale, .div = div}, &b, i);
 }
 
 void fluid_divergence(const fluid_t *f, double *div) { fluid_divergence_scaled(f, 1.0, div); }
@@ -198,7 +221,7 @@ void fluid_div_cfl_interior_plane(const fluid_t *f, int i, double *m)
     split_interior_plane(f, &(split_pass_t){.m = m}, i);
 }
 
-void fluid_div_cfl_rest(const fluid_t *f, double *m) { split_rest(f, &(split_pass_t){.m = m}); }
+void fluid_div_cfl_rest(const fluid_t *f, double *m) { split_rest(f, &(split_pass_t){.m = m}, 0); }
 
 double fluid_max_divergence(const fluid_t *f)
 {

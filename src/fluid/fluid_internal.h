@@ -79,14 +79,16 @@ void fluid_rhs_predict(const fluid_t *f, double ca, double cv, double dg, double
  * leave planes i − 1 … i + 1 of u and p final, ghosts included (step.c's
  * deferred correction); `done` (or NULL) is called when plane i of u* is
  * written, before its divergence: it may change u* on plane i (step.c's
- * plane hook: the immersed-boundary forcing) */
+ * plane hook: the immersed-boundary forcing); `after_div` (or NULL) after
+ * the divergence of plane i (step.c: the plane's remaining cells and its
+ * forward transform for the pressure solve) */
 typedef struct {
     void (*fn)(void *ctx, int i);
     void *ctx;
 } fluid_ahead_t;
 void fluid_rhs_predict_div(const fluid_t *f, double ca, double cv, double dg, double dz, double adt, double ce,
                            double *const H[3], double *const US[3], double div_scale, double *div,
-                           const fluid_ahead_t *ahead, const fluid_ahead_t *done);
+                           const fluid_ahead_t *ahead, const fluid_ahead_t *done, const fluid_ahead_t *after_div);
 /* viscous.c */
 void fluid_laplacian_add(const fluid_t *f, int c, const double *u, double scale, double *out);
 void fluid_wall_terms_add(const fluid_t *f, int c, double scale, double *out);
@@ -97,6 +99,8 @@ void fluid_fill_pressure_ghosts(const fluid_t *f, double *p);
 /* fluid_apply_bc in parts: the edge planes' ghosts, then an inner plane's */
 void fluid_apply_bc_edges(fluid_t *f);
 void fluid_apply_bc_plane(fluid_t *f, int i);
+/* the same ghosts of plane i for the velocity arrays u (not yet f->u) */
+void fluid_apply_bc_plane_of(const fluid_t *f, double *const u[3], int i);
 /* timestep.c: max over cells of Σ_d |u_d|/Δ_d (|u_d| the larger of the two faces) */
 double fluid_convective_rate(const fluid_t *f);
 /* diagnostics.c: ke, div_max, cfl of f->diag from the current field (stats:
@@ -109,7 +113,9 @@ void fluid_update_diagnostics(fluid_t *f, const double *stats, const double *div
  * unknowns of this rank, computed by a sweep as soon as a plane is final, and
  * the rest computed after the ghosts are filled; see diagnostics.c. */
 void fluid_divergence_interior_plane(const fluid_t *f, const double *const uu[3], double scale, double *div, int i);
-void fluid_divergence_rest(const fluid_t *f, double scale, double *div);
+void fluid_divergence_rest(const fluid_t *f, double scale, double *div, int edges_only);
+void fluid_interior_planes(const grid_t *g, int *ilo, int *ihi);
+void fluid_divergence_rest_plane(const fluid_t *f, const double *const uu[3], double scale, double *div, int i);
 void fluid_div_cfl_interior_plane(const fluid_t *f, int i, double *m);
 void fluid_div_cfl_rest(const fluid_t *f, double *m);
 /* step.c */

@@ -309,6 +309,31 @@ static void plane_hook_at(void *ctx, int i)
     c->f->plane_hook(c->f, c->us, c->stage, c->adt, i, c->f->hook_ctx);
 }
 
+/* The forward transforms of the pressure solve inside the predictor sweep
+ * (theory §1, step 1.1c; fluid_ahead_t of the sweep's `after_div`): once
+ * the sweep has written the interior cells of D u* on plane i, the ghosts
+ * of plane i of u* are filled (the values fluid_apply_bc gives them after
+ * the sweep), the plane's cells next to the y and z faces follow, and the
+ * plane's forward transform is taken while it is in cache; the solve then
+ * transforms only the planes of the edges, which read the x ghosts.  The
+ * same operations on the same values: bit-identical. */
+typedef struct {
+    fluid_t *f;
+    double *const *us;
+    double scale;
+    int ilo, ihi;
+} forward_plane_call_t;
+
+static void forward_plane_at(void *ctx, int i)
+{
+    forward_plane_call_t *c = ctx;
+    if (i < c->ilo || i >= c->ihi) return;
+    fluid_priv_t *q = fluid_priv(c->f);
+    fluid_apply_bc_plane_of(c->f, c->us, i);
+    fluid_divergence_rest_plane(c->f, (const double *const *)c->us, c->scale, q->work, i);
+    poisson_forward_plane(q->pp, q->work, i);
+}
+
 void fluid_step(fluid_t *f, double dt)
 {
     const grid_t *g = f->g;
@@ -329,11 +354,14 @@ void fluid_step(fluid_t *f, double dt)
      *   done inside the next predictor sweep, when nothing reads u^k in
      *   between (no stage-end hook, or one that promised not to) and the
      *   sweep is the fused one. */
-    int fuse_plane = 0, fuse_div = 0, defer = 0;
+    int fuse_plane = 0, fuse_div = 0, defer = 0, fwd_planes = 0;
     deferred_correction_t dc = {.f = f};
     fluid_ahead_t ahead = {deferred_ahead, &dc};
     plane_hook_call_t phc = {.f = f};
     fluid_ahead_t done = {plane_hook_at, &phc};
+    forward_plane_call_t fpc = {.f = f};
+    fluid_ahead_t after_div = {forward_plane_at, &fpc};
+    fluid_interior_planes(g, &fpc.ilo, &fpc.ihi);
     int pending = 0;
     for (int s = 0; s < 3; s++) {
         double adt = (fluid_rk_gamma[s] + fluid_rk_zeta[s]) * dt;
@@ -343,7 +371,10 @@ void fluid_step(fluid_t *f, double dt)
             fuse_plane = f->plane_hook && is3d && !impl && !q->wq_any;
             fuse_div = is3d && !impl && keeps && (!f->plane_hook || fuse_plane);
             defer = fuse_div && (!f->stage_end_hook || (f->hook_flags & FLUID_HOOK_IDLE_UK));
-            if (f->prm.unfused) fuse_plane = fuse_div = defer = 0;
+            /* forward transforms in the sweep (step 1.1c) when D u* is
+             * final there: no wall terms after the sweep, a solver by planes */
+            fwd_planes = fuse_div && !q->wq_any && poisson_solve_by_planes(q->pp);
+            if (f->prm.unfused) fuse_plane = fuse_div = defer = fwd_planes = 0;
         }
         /* H^k = −∇·(u⊗u) [+ νLu] from u^{k−1} (its ghosts are valid: every
          * stage ends with them) into spare, and the predictor
@@ -356,9 +387,12 @@ void fluid_step(fluid_t *f, double dt)
         phc.us = q->h;
         phc.stage = s;
         phc.adt = adt;
+        fpc.us = q->h;
+        fpc.scale = 1.0 / adt;
         fluid_rhs_predict_div(f, -1.0, impl ? 0.0 : f->prm.nu, dt * fluid_rk_gamma[s], dt * fluid_rk_zeta[s], adt,
                               impl ? 0.5 * adt * f->prm.nu : 0.0, s < 2 ? q->spare : NULL, q->h, 1.0 / adt,
-                              fuse_div ? q->work : NULL, pending ? &ahead : NULL, fuse_plane ? &done : NULL);
+                              fuse_div ? q->work : NULL, pending ? &ahead : NULL, fuse_plane ? &done : NULL,
+                              fwd_planes ? &after_div : NULL);
         pending = 0;
         for (int c = 0; c < nc; c++) {
             double *old = f->u[c];
@@ -371,7 +405,7 @@ void fluid_step(fluid_t *f, double dt)
         if (f->plane_hook && !fuse_plane)
             for (int i = 0; i < g->nxl; i++) f->plane_hook(f, f->u, s, adt, i, f->hook_ctx);
         fluid_apply_bc(f);
-        if (fuse_div) fluid_divergence_rest(f, 1.0 / adt, q->work);
+        if (fuse_div) fluid_divergence_rest(f, 1.0 / adt, q->work, fwd_planes);
         if (f->stage_hook) {
             f->stage_hook(f, s, adt, f->hook_ctx);
             if (!(f->hook_flags & FLUID_HOOK_KEEPS_USTAR)) fluid_apply_bc(f);

@@ -132,6 +132,7 @@ typedef struct {
      * reordered copy of the plane (pbuf, in cache) */
     double *pbuf;
     fftw_plan pfwd, pinv;
+    unsigned char *fwd_ready;  /* plane i already forward-transformed (poisson_forward_plane) */
 
     /* decomposition of the rows among ranks (P > 1) */
     int P, me;
@@ -1042,6 +1043,7 @@ static void *fft_create(poisson_t *p)
     free(f);
     if (t->nxu > 0) {
         if (t->reord) t->pbuf = xcalloc((size_t)ny * nz, sizeof(double));
+        if (t->reord) t->fwd_ready = xcalloc((size_t)(t->nxu > 0 ? t->nxu : 1), 1);
         setup_steps(t);
     }
     if (p->opt.fftw_measure)
@@ -1320,7 +1322,12 @@ static void fft_forward_and_modes(fft_t *t, double lambda, const double *b)
     long o = G_IDX(g, 0, 0, 0);
     scratch_attach(t);
     if (t->nxu > 0) {
-        if (t->reord) plane_transforms(t, (double *)b + o, 0);
+        if (t->reord)
+            for (int i = 0; i < t->nxu; i++) {
+                /* a plane poisson_forward_plane transformed ahead is not read again */
+                if (t->fwd_ready[i]) t->fwd_ready[i] = 0;
+                else plane_transform(t, (double *)b + o, 0, i);
+            }
         for (int k = 0; k < t->nsteps; k++) step_run(t, &t->fwd[k], (double *)b + o);
         if (t->reord && !t->fused) fast_butterfly(t, 0);
     }
@@ -1388,6 +1395,22 @@ void poisson_solve_begin(poisson_t *p, double lambda, const double *b)
 
 void poisson_solve_plane(poisson_t *p, double *x, int i) { plane_transform(p->impl, x + G_IDX(p->g, 0, 0, 0), 1, i); }
 
+/* The forward transform of plane i of b ahead of the solve (by planes): the
+ * writer of b calls it once plane i of b is final, while the plane is still
+ * in cache, and the next solve (poisson_solve or poisson_solve_begin with
+ * that b) transforms only the planes not done ahead.  The same transform of
+ * the same values: bit-identical.  The transformed plane goes to the shared
+ * work array, so no other solve may run in between; a plane of a deferred
+ * solution must have been written out (poisson_solve_plane) before. */
+void poisson_forward_plane(poisson_t *p, const double *b, int i)
+{
+    if (!fft_by_planes(p)) die("poisson_forward_plane: not available for this solver");
+    fft_t *t = p->impl;
+    scratch_attach(t);
+    plane_transform(t, (double *)b + G_IDX(p->g, 0, 0, 0), 0, i);
+    t->fwd_ready[i] = 1;
+}
+
 static void fft_destroy(void *impl)
 {
     fft_t *t = impl;
@@ -1403,6 +1426,7 @@ static void fft_destroy(void *impl)
     free(t->rcount);
     free(t->rdispl);
     free(t->pbuf);
+    free(t->fwd_ready);
     free(t->rowlist);
     scratch_release(0);
     if (t->P > 1) scratch_release(1);
