@@ -198,6 +198,14 @@ static void test_deferred_correction(void **state)
     bc.vel[1][1][0] = 1.0;
     bc.vel[1][1][2] = 0.3;
     check_deferred(&bc, STRETCH_UNIFORM);
+    /* y and z periodic (the plane-by-plane transforms without reordering):
+     * x no-slip walls (stretched), then triply periodic */
+    memset(&bc, 0, sizeof bc);
+    bc.type[0][0] = bc.type[0][1] = BC_NOSLIP;
+    bc.vel[0][1][1] = 0.7;
+    check_deferred(&bc, STRETCH_TANH_BOTH);
+    memset(&bc, 0, sizeof bc);
+    check_deferred(&bc, STRETCH_UNIFORM);
 }
 
 /* ---- divergence-free test fields ---------------------------------------- */

@@ -124,6 +124,7 @@ typedef struct {
     long RS, PS;
     step_t fwd[2], inv[2];     /* forward: [0] then [1]; inverse: [0] then [1] */
     int nsteps;
+    int per_plane;             /* the one step is a plane's 2-D transform, run plane by plane */
     /* fast path: 2-D DFT with Makhoul reordering of the Neumann directions */
     int fast, ynn, znn, reord; /* reord = ynn || znn */
     int fused;                 /* butterflies applied inside the tridiagonal sweeps (one rank) */
@@ -261,11 +262,11 @@ static void step_plan(fft_t *t, step_t *s, int a, unsigned planner)
 
 /* Run step s; f is the field (pointer to its first interior unknown) when a
  * side of the step is the field. */
-static void step_run(fft_t *t, step_t *s, double *f)
+static void step_exec(fft_t *t, step_t *s, double *f, double *work)
 {
     int a = (s->in == SIDE_FIELD || s->out == SIDE_FIELD) ? fftw_alignment_of(f) != 0 : 0;
     if (!s->plan[a]) step_plan(t, s, a, t->lazy_flags);
-    double *side[2] = {f, t->work};
+    double *side[2] = {f, work};
     double *in = side[s->in], *out = side[s->out];
     fftw_plan pl = s->plan[a];
     switch (s->kind) {
@@ -275,6 +276,8 @@ static void step_run(fft_t *t, step_t *s, double *f)
     case TK_C2C: fftw_execute_dft(pl, (fftw_complex *)in, (fftw_complex *)out); break;
     }
 }
+
+static void step_run(fft_t *t, step_t *s, double *f) { step_exec(t, s, f, t->work); }
 
 /* The transform pipeline.
  * Fast path: one 2-D r2c over (y, z) for all x planes when both are
@@ -290,12 +293,17 @@ static void setup_steps(fft_t *t)
     int nxu = t->nxu, ny = t->ny, nz = t->nz, TC = t->TC;
     fftw_iodim none = {0, 0, 0};
     if (t->fast && !t->reord) {
-        /* both periodic: one 2-D r2c from the field */
+        /* both periodic: the 2-D r2c of one x plane, from the field, run
+         * plane by plane (plane_transform): measured 1.5-1.7x faster than the
+         * same transform with the planes as FFTW's loop (128^3, both
+         * planners; the loop's plan walks all planes per pass) */
         t->nsteps = 1;
-        t->fwd[0] = step_make(TK_R2C, 0, 0, SIDE_FIELD, SIDE_WORK, 2, iod(ny, sy, RS / 2), iod(nz, 1, 1), 1,
-                              iod(nxu, sx, PS / 2), none);
-        t->inv[0] = step_make(TK_C2R, 0, 0, SIDE_WORK, SIDE_FIELD, 2, iod(ny, RS / 2, sy), iod(nz, 1, 1), 1,
-                              iod(nxu, PS / 2, sx), none);
+        t->per_plane = 1;
+        t->fwd[0] = step_make(TK_R2C, 0, 0, SIDE_FIELD, SIDE_WORK, 2, iod(ny, sy, RS / 2), iod(nz, 1, 1), 0, none,
+                              none);
+        t->inv[0] = step_make(TK_C2R, 0, 0, SIDE_WORK, SIDE_FIELD, 2, iod(ny, RS / 2, sy), iod(nz, 1, 1), 0, none,
+                              none);
+        (void)sx;
     } else if (t->fast) {
         t->nsteps = 0; /* plane_transforms */
     } else if (t->dim3) {
@@ -345,6 +353,11 @@ static void setup_steps(fft_t *t)
 static void plane_transform(fft_t *t, double *f, int inverse, int i)
 {
     const grid_t *g = t->p->g;
+    if (t->per_plane) {
+        /* periodic y and z: the plane's step, straight from / to the field */
+        step_exec(t, inverse ? &t->inv[0] : &t->fwd[0], f + (long)i * g->sx, t->work + i * t->PS);
+        return;
+    }
     int ny = t->ny, nz = t->nz, hz = nz / 2;
     long o = G_IDX(g, 0, 0, 0);
     fftw_complex *w = (fftw_complex *)(t->work + i * t->PS);
@@ -397,6 +410,12 @@ static void plans_make(fft_t *t, int a)
     for (int k = 0; k < t->nsteps; k++) {
         step_plan(t, &t->fwd[k], a, t->plan_flags);
         step_plan(t, &t->inv[k], a, t->plan_flags);
+    }
+    /* plane by plane with an odd plane stride: the planes alternate between
+     * the two alignment classes */
+    if (t->per_plane && t->nxu > 1 && t->p->g->sx % 2) {
+        step_plan(t, &t->fwd[0], !a, t->plan_flags);
+        step_plan(t, &t->inv[0], !a, t->plan_flags);
     }
 }
 
@@ -1043,8 +1062,8 @@ static void *fft_create(poisson_t *p)
     free(f);
     if (t->nxu > 0) {
         if (t->reord) t->pbuf = xcalloc((size_t)ny * nz, sizeof(double));
-        if (t->reord) t->fwd_ready = xcalloc((size_t)(t->nxu > 0 ? t->nxu : 1), 1);
         setup_steps(t);
+        if (t->reord || t->per_plane) t->fwd_ready = xcalloc((size_t)t->nxu, 1);
     }
     if (p->opt.fftw_measure)
         plans_measure(t, a);
@@ -1322,13 +1341,14 @@ static void fft_forward_and_modes(fft_t *t, double lambda, const double *b)
     long o = G_IDX(g, 0, 0, 0);
     scratch_attach(t);
     if (t->nxu > 0) {
-        if (t->reord)
+        if (t->reord || t->per_plane)
             for (int i = 0; i < t->nxu; i++) {
                 /* a plane poisson_forward_plane transformed ahead is not read again */
                 if (t->fwd_ready[i]) t->fwd_ready[i] = 0;
                 else plane_transform(t, (double *)b + o, 0, i);
             }
-        for (int k = 0; k < t->nsteps; k++) step_run(t, &t->fwd[k], (double *)b + o);
+        else
+            for (int k = 0; k < t->nsteps; k++) step_run(t, &t->fwd[k], (double *)b + o);
         if (t->reord && !t->fused) fast_butterfly(t, 0);
     }
     if (t->P > 1)
@@ -1350,8 +1370,9 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
     fft_forward_and_modes(t, lambda, b);
     if (t->nxu > 0) {
         if (t->reord && !t->fused) fast_butterfly(t, 1);
-        for (int k = 0; k < t->nsteps; k++) step_run(t, &t->inv[k], x + o);
-        if (t->reord) plane_transforms(t, x + o, 1);
+        if (t->reord || t->per_plane) plane_transforms(t, x + o, 1);
+        else
+            for (int k = 0; k < t->nsteps; k++) step_run(t, &t->inv[k], x + o);
     }
     /* boundary values of Dirichlet faces (not unknowns) are zero */
     int nz = g->n[2];
@@ -1369,8 +1390,9 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
 
 /* ---- the solve in two parts ------------------------------------------------
  *
- * On one rank with the reordered transforms (every box with Neumann y or z
- * pairs: walls), the inverse transforms write x one plane at a time
+ * On one rank with the transforms by planes (every box with Neumann y or z
+ * pairs, the reordered transforms, and boxes periodic in y and z), the
+ * inverse transforms write x one plane at a time
  * (plane_transforms), so a caller that reads x plane by plane — the deferred
  * correction of the fluid step — can have each plane written just before it
  * reads it, while it is in cache, instead of in a pass of its own.
@@ -1381,7 +1403,7 @@ static int fft_by_planes(const poisson_t *p)
 {
     const fft_t *t = p->impl;
     const grid_t *g = p->g;
-    return p->backend == &poisson_backend_fft && t && t->reord && t->P == 1 && t->nsteps == 0 && t->nxu == g->nxl &&
+    return p->backend == &poisson_backend_fft && t && (t->reord || t->per_plane) && t->P == 1 && t->nxu == g->nxl &&
            t->ny == g->n[1] && t->nz == g->n[2];
 }
 
