@@ -73,6 +73,17 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* The default planner: FFTW_ESTIMATE, which picks an algorithm from an
+ * operation-count estimate without timing anything (the same plans in every
+ * run), over the wider set of algorithms FFTW's patient planner considers
+ * (FFTW_ESTIMATE_PATIENT, a flag of fftw3.h's "beyond-guru" set; still no
+ * timing).  For the 2-D r2c of a 128 x 128 plane plain ESTIMATE takes the
+ * scalar straight-line codelet of length 128 along z; with the wider set it
+ * takes the SIMD Cooley-Tukey split FFTW_MEASURE also picks: 4.6 -> 2.9 ms
+ * for the forward transforms of 128 planes (MEASURE 3.0 ms), 6.9 -> 5.4 ms
+ * for the inverse (measured, bench notes in docs/performance.md). */
+#define PLANNER_ESTIMATE (FFTW_ESTIMATE | FFTW_ESTIMATE_PATIENT)
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -124,7 +135,7 @@ typedef struct {
     long RS, PS;
     step_t fwd[2], inv[2];     /* forward: [0] then [1]; inverse: [0] then [1] */
     int nsteps;
-    int per_plane;             /* the one step is a plane's 2-D transform, run plane by plane */
+    int planes;                /* the fast path: 2-D transforms plane by plane through pbuf (plane_transform) */
     /* fast path: 2-D DFT with Makhoul reordering of the Neumann directions */
     int fast, ynn, znn, reord; /* reord = ynn || znn */
     int fused;                 /* butterflies applied inside the tridiagonal sweeps (one rank) */
@@ -133,6 +144,12 @@ typedef struct {
      * reordered copy of the plane (pbuf, in cache) */
     double *pbuf;
     fftw_plan pfwd, pinv;
+    /* nz even: the plane's r2c as a complex DFT of length nz/2 of each row
+     * (even and odd values as real and imaginary parts), a split pass, and
+     * the complex DFT of the columns (plane_r2c); c2r in reverse */
+    int half;
+    fftw_plan prow_f, prow_b, pcol_f, pcol_b;
+    double *tw;                /* W^k = e^{−2πik/nz}, k = 0 … nz/2 (re, im) */
     unsigned char *fwd_ready;  /* plane i already forward-transformed (poisson_forward_plane) */
 
     /* decomposition of the rows among ranks (P > 1) */
@@ -292,19 +309,7 @@ static void setup_steps(fft_t *t)
     long sx = g->sx, sy = g->sy, RS = t->RS, PS = t->PS;
     int nxu = t->nxu, ny = t->ny, nz = t->nz, TC = t->TC;
     fftw_iodim none = {0, 0, 0};
-    if (t->fast && !t->reord) {
-        /* both periodic: the 2-D r2c of one x plane, from the field, run
-         * plane by plane (plane_transform): measured 1.5-1.7x faster than the
-         * same transform with the planes as FFTW's loop (128^3, both
-         * planners; the loop's plan walks all planes per pass) */
-        t->nsteps = 1;
-        t->per_plane = 1;
-        t->fwd[0] = step_make(TK_R2C, 0, 0, SIDE_FIELD, SIDE_WORK, 2, iod(ny, sy, RS / 2), iod(nz, 1, 1), 0, none,
-                              none);
-        t->inv[0] = step_make(TK_C2R, 0, 0, SIDE_WORK, SIDE_FIELD, 2, iod(ny, RS / 2, sy), iod(nz, 1, 1), 0, none,
-                              none);
-        (void)sx;
-    } else if (t->fast) {
+    if (t->fast) {
         t->nsteps = 0; /* plane_transforms */
     } else if (t->dim3) {
         t->nsteps = 2;
@@ -344,24 +349,114 @@ static void setup_steps(fft_t *t)
     }
 }
 
-/* Transforms of the reordering fast path, one x plane at a time.  Forward:
- * gather the plane reordered (Makhoul: v(n) = x(2n), v(N−1−n) = x(2n+1) in
- * each Neumann direction; row n1 comes from field row p_y(n1)) into pbuf,
- * which stays in cache, then one 2-D r2c into the work plane.  Inverse: c2r
- * of the work plane into pbuf, scattered back.  This costs no extra pass
- * over memory compared with a transform from the field. */
+/* ---- the 2-D r2c / c2r of one plane --------------------------------------
+ *
+ * For an even row length N = 2M, the r2c of a real row x is computed as the
+ * complex DFT of length M of z_m = x_2m + i x_2m+1, Z = E + iO with E, O the
+ * DFTs of the even and odd values, followed by the split
+ *     E_k = ½(Z_k + conj Z_{M−k}),  O_k = −½i(Z_k − conj Z_{M−k}),
+ *     X_k = E_k + W^k O_k  (k = 0 … M, Z_M = Z_0, W = e^{−2πi/N}),
+ * X exactly FFTW's unnormalised r2c output; the c2r runs it backwards,
+ *     Z_k = E_k + iO_k,  E_k = X_k + conj X_{M−k},  O_k = W^{−k}(X_k − conj X_{M−k}),
+ * then the inverse complex DFT of length M (N x as from FFTW's c2r, which
+ * also ignores the imaginary parts of X_0 and X_M).  Why not FFTW's r2c: the
+ * default planner (FFTW_ESTIMATE, no timing) takes the scalar straight-line
+ * r2c codelet of the whole row, while complex DFTs get its SIMD codelets;
+ * with FFTW_MEASURE it picks a split of the same kind itself.  Measured on
+ * 128 planes of 128 x 128 (2026-11-26): FFTW's 2-D r2c 4.2 ms (ESTIMATE),
+ * 2.8 ms (MEASURE); c2r 5.7 and 4.4 ms. */
+static void split_rows(const fft_t *t, double *w)
+{
+    const int M = t->nz / 2, ny = t->ny;
+    const double *tw = t->tw;
+    for (int r = 0; r < ny; r++) {
+        double *x = w + r * t->RS;
+        double a = x[0], b = x[1];
+        x[0] = a + b;
+        x[1] = 0.0;
+        x[2 * M] = a - b;
+        x[2 * M + 1] = 0.0;
+        for (int k = 1; 2 * k <= M; k++) {
+            int j = M - k;
+            double zkr = x[2 * k], zki = x[2 * k + 1], zjr = x[2 * j], zji = x[2 * j + 1];
+            double er = 0.5 * (zkr + zjr), ei = 0.5 * (zki - zji);
+            double orr = 0.5 * (zki + zji), oi = -0.5 * (zkr - zjr);
+            double c = tw[2 * k], sn = tw[2 * k + 1];
+            x[2 * k] = er + c * orr - sn * oi;
+            x[2 * k + 1] = ei + c * oi + sn * orr;
+            if (j != k) {
+                x[2 * j] = er - c * orr + sn * oi;
+                x[2 * j + 1] = -ei + c * oi + sn * orr;
+            }
+        }
+    }
+}
+
+static void merge_rows(const fft_t *t, double *w)
+{
+    const int M = t->nz / 2, ny = t->ny;
+    const double *tw = t->tw;
+    for (int r = 0; r < ny; r++) {
+        double *x = w + r * t->RS;
+        double p = x[0], q = x[2 * M];
+        x[0] = p + q;
+        x[1] = p - q;
+        for (int k = 1; 2 * k <= M; k++) {
+            int j = M - k;
+            double xkr = x[2 * k], xki = x[2 * k + 1], xjr = x[2 * j], xji = x[2 * j + 1];
+            double er = xkr + xjr, ei = xki - xji, dr = xkr - xjr, di = xki + xji;
+            double c = tw[2 * k], sn = tw[2 * k + 1];
+            /* O_k = conj(W^k) D_k, O_j = −W^k conj(D_k) */
+            double okr = c * dr + sn * di, oki = c * di - sn * dr;
+            x[2 * k] = er - oki;
+            x[2 * k + 1] = ei + okr;
+            if (j != k) {
+                double ojr = c * dr + sn * di, oji = -c * di + sn * dr;
+                x[2 * j] = er - oji;
+                x[2 * j + 1] = -ei + ojr;
+            }
+        }
+    }
+}
+
+/* FFTW's r2c of pbuf into the work plane w, or the split path (destroys pbuf) */
+static void plane_r2c(fft_t *t, fftw_complex *w)
+{
+    if (!t->half) {
+        fftw_execute_dft_r2c(t->pfwd, t->pbuf, w);
+        return;
+    }
+    fftw_execute_dft(t->prow_f, (fftw_complex *)t->pbuf, w);
+    split_rows(t, (double *)w);
+    fftw_execute_dft(t->pcol_f, w, w);
+}
+
+/* the inverse: work plane w (destroyed) into pbuf */
+static void plane_c2r(fft_t *t, fftw_complex *w)
+{
+    if (!t->half) {
+        fftw_execute_dft_c2r(t->pinv, w, t->pbuf);
+        return;
+    }
+    fftw_execute_dft(t->pcol_b, w, w);
+    merge_rows(t, (double *)w);
+    fftw_execute_dft(t->prow_b, w, (fftw_complex *)t->pbuf);
+}
+
+/* Transforms of the fast path, one x plane at a time.  Forward: gather the
+ * plane into pbuf, which stays in cache, reordered in each Neumann direction
+ * (Makhoul: v(n) = x(2n), v(N−1−n) = x(2n+1); row n1 comes from field row
+ * p_y(n1)) and copied as it is in a periodic one, then the plane's 2-D r2c
+ * into the work plane (plane_r2c).  Inverse: c2r of the work plane into
+ * pbuf, scattered back.  This costs no extra pass over memory compared with
+ * a transform from the field. */
 static void plane_transform(fft_t *t, double *f, int inverse, int i)
 {
     const grid_t *g = t->p->g;
-    if (t->per_plane) {
-        /* periodic y and z: the plane's step, straight from / to the field */
-        step_exec(t, inverse ? &t->inv[0] : &t->fwd[0], f + (long)i * g->sx, t->work + i * t->PS);
-        return;
-    }
     int ny = t->ny, nz = t->nz, hz = nz / 2;
     long o = G_IDX(g, 0, 0, 0);
     fftw_complex *w = (fftw_complex *)(t->work + i * t->PS);
-    if (inverse) fftw_execute_dft_c2r(t->pinv, w, t->pbuf);
+    if (inverse) plane_c2r(t, w);
     for (int n1 = 0; n1 < ny; n1++) {
         int j = !t->ynn ? n1 : n1 < ny / 2 ? 2 * n1 : 2 * (ny - 1 - n1) + 1;
         double *restrict fr = f + G_IDX(g, i, j, 0) - o;
@@ -379,7 +474,7 @@ static void plane_transform(fft_t *t, double *f, int inverse, int i)
             for (int m = 0; m < hz; m++) zr[nz - 1 - m] = fr[2 * m + 1];
         }
     }
-    if (!inverse) fftw_execute_dft_r2c(t->pfwd, t->pbuf, w);
+    if (!inverse) plane_r2c(t, w);
 }
 
 static void plane_transforms(fft_t *t, double *f, int inverse)
@@ -390,6 +485,21 @@ static void plane_transforms(fft_t *t, double *f, int inverse)
 static void plane_plans(fft_t *t)
 {
     int ny = t->ny, nz = t->nz;
+    if (t->half) {
+        int M = nz / 2, rs = (int)(t->RS / 2);
+        fftw_complex *pb = (fftw_complex *)t->pbuf, *wk = (fftw_complex *)t->work;
+        fftw_iodim dr = iod(M, 1, 1), hrf = iod(ny, M, rs), hrb = iod(ny, rs, M);
+        fftw_iodim dc = iod(ny, rs, rs), hc = iod(M + 1, 1, 1);
+        unsigned fl = t->plan_flags | FFTW_DESTROY_INPUT;
+        t->prow_f = fftw_plan_guru_dft(1, &dr, 1, &hrf, pb, wk, FFTW_FORWARD, fl);
+        t->prow_b = fftw_plan_guru_dft(1, &dr, 1, &hrb, wk, pb, FFTW_BACKWARD, fl);
+        t->pcol_f = fftw_plan_guru_dft(1, &dc, 1, &hc, wk, wk, FFTW_FORWARD, fl);
+        t->pcol_b = fftw_plan_guru_dft(1, &dc, 1, &hc, wk, wk, FFTW_BACKWARD, fl);
+        if (!t->prow_f || !t->prow_b || !t->pcol_f || !t->pcol_b)
+            die("poisson fft: FFTW could not plan a transform%s",
+                t->plan_flags & FFTW_WISDOM_ONLY ? " from the merged wisdom (an entry is missing)" : "");
+        return;
+    }
     fftw_iodim df[2] = {iod(ny, nz, t->RS / 2), iod(nz, 1, 1)}, di[2] = {iod(ny, t->RS / 2, nz), iod(nz, 1, 1)};
     t->pfwd = fftw_plan_guru_dft_r2c(2, df, 0, NULL, t->pbuf, (fftw_complex *)t->work,
                                      t->plan_flags | FFTW_DESTROY_INPUT);
@@ -406,16 +516,10 @@ static void plane_plans(fft_t *t)
 static void plans_make(fft_t *t, int a)
 {
     if (t->nxu == 0) return;
-    if (t->reord) plane_plans(t);
+    if (t->planes) plane_plans(t);
     for (int k = 0; k < t->nsteps; k++) {
         step_plan(t, &t->fwd[k], a, t->plan_flags);
         step_plan(t, &t->inv[k], a, t->plan_flags);
-    }
-    /* plane by plane with an odd plane stride: the planes alternate between
-     * the two alignment classes */
-    if (t->per_plane && t->nxu > 1 && t->p->g->sx % 2) {
-        step_plan(t, &t->fwd[0], !a, t->plan_flags);
-        step_plan(t, &t->inv[0], !a, t->plan_flags);
     }
 }
 
@@ -430,6 +534,11 @@ static void plans_destroy(fft_t *t)
     if (t->pfwd) fftw_destroy_plan(t->pfwd);
     if (t->pinv) fftw_destroy_plan(t->pinv);
     t->pfwd = t->pinv = NULL;
+    fftw_plan *hp[4] = {&t->prow_f, &t->prow_b, &t->pcol_f, &t->pcol_b};
+    for (int k = 0; k < 4; k++) {
+        if (*hp[k]) fftw_destroy_plan(*hp[k]);
+        *hp[k] = NULL;
+    }
 }
 
 /* The pass that turns the 2-D DFT V of the reordered data into the cosine
@@ -913,17 +1022,18 @@ static void *fft_create(poisson_t *p)
         t->dz.eig = xcalloc(1, sizeof(double));
     }
     if (t->dy.m != t->ny || t->dz.m != t->nz) die("poisson fft: unknown counts disagree with the transforms");
-    t->plan_flags = p->opt.fftw_measure ? FFTW_MEASURE : FFTW_ESTIMATE;
+    t->plan_flags = p->opt.fftw_measure ? FFTW_MEASURE : PLANNER_ESTIMATE;
     /* a plan made during the run (a field of the other alignment class) is
      * not in the wisdom of a measuring run: estimated, hence the same in
      * every run given the same wisdom */
-    t->lazy_flags = FFTW_ESTIMATE;
+    t->lazy_flags = PLANNER_ESTIMATE;
     int nx = t->nx, ny = t->ny, nz = t->nz;
     t->fast = t->dim3 && (t->dy.periodic || (t->dy.neumann && ny % 2 == 0)) &&
               (t->dz.periodic || (t->dz.neumann && nz % 2 == 0));
     t->ynn = t->fast && t->dy.neumann;
     t->znn = t->fast && t->dz.neumann;
     t->reord = t->ynn || t->znn;
+    t->planes = t->fast;
     t->scale = t->fast ? 1.0 / ((double)ny * nz) : 1.0 / (t->dy.norm * t->dz.norm);
 
     /* shape of a transformed plane and the eigenvalues of its rows/columns */
@@ -1061,9 +1171,17 @@ static void *fft_create(poisson_t *p)
     int a = fftw_alignment_of(f + G_IDX(g, 0, 0, 0)) != 0;
     free(f);
     if (t->nxu > 0) {
-        if (t->reord) t->pbuf = xcalloc((size_t)ny * nz, sizeof(double));
+        if (t->planes) t->pbuf = xcalloc((size_t)ny * nz, sizeof(double));
+        t->half = t->planes && nz % 2 == 0;
+        if (t->half) {
+            t->tw = xcalloc((size_t)nz + 2, sizeof(double));
+            for (int k = 0; k <= nz / 2; k++) {
+                t->tw[2 * k] = cos(2.0 * M_PI * k / nz);
+                t->tw[2 * k + 1] = -sin(2.0 * M_PI * k / nz);
+            }
+        }
         setup_steps(t);
-        if (t->reord || t->per_plane) t->fwd_ready = xcalloc((size_t)t->nxu, 1);
+        if (t->planes) t->fwd_ready = xcalloc((size_t)t->nxu, 1);
     }
     if (p->opt.fftw_measure)
         plans_measure(t, a);
@@ -1341,7 +1459,7 @@ static void fft_forward_and_modes(fft_t *t, double lambda, const double *b)
     long o = G_IDX(g, 0, 0, 0);
     scratch_attach(t);
     if (t->nxu > 0) {
-        if (t->reord || t->per_plane)
+        if (t->planes)
             for (int i = 0; i < t->nxu; i++) {
                 /* a plane poisson_forward_plane transformed ahead is not read again */
                 if (t->fwd_ready[i]) t->fwd_ready[i] = 0;
@@ -1370,7 +1488,7 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
     fft_forward_and_modes(t, lambda, b);
     if (t->nxu > 0) {
         if (t->reord && !t->fused) fast_butterfly(t, 1);
-        if (t->reord || t->per_plane) plane_transforms(t, x + o, 1);
+        if (t->planes) plane_transforms(t, x + o, 1);
         else
             for (int k = 0; k < t->nsteps; k++) step_run(t, &t->inv[k], x + o);
     }
@@ -1403,7 +1521,7 @@ static int fft_by_planes(const poisson_t *p)
 {
     const fft_t *t = p->impl;
     const grid_t *g = p->g;
-    return p->backend == &poisson_backend_fft && t && (t->reord || t->per_plane) && t->P == 1 && t->nxu == g->nxl &&
+    return p->backend == &poisson_backend_fft && t && t->planes && t->P == 1 && t->nxu == g->nxl &&
            t->ny == g->n[1] && t->nz == g->n[2];
 }
 
@@ -1448,6 +1566,7 @@ static void fft_destroy(void *impl)
     free(t->rcount);
     free(t->rdispl);
     free(t->pbuf);
+    free(t->tw);
     free(t->fwd_ready);
     free(t->rowlist);
     scratch_release(0);
