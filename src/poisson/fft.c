@@ -467,11 +467,16 @@ static void plane_transform(fft_t *t, double *f, int inverse, int i)
             else
                 memcpy(zr, fr, (size_t)nz * sizeof(double));
         } else if (inverse) {
-            for (int m = 0; m < hz; m++) fr[2 * m] = zr[m];
-            for (int m = 0; m < hz; m++) fr[2 * m + 1] = zr[nz - 1 - m];
+            /* one loop: each cache line of the field row written once */
+            for (int m = 0; m < hz; m++) {
+                fr[2 * m] = zr[m];
+                fr[2 * m + 1] = zr[nz - 1 - m];
+            }
         } else {
-            for (int m = 0; m < hz; m++) zr[m] = fr[2 * m];
-            for (int m = 0; m < hz; m++) zr[nz - 1 - m] = fr[2 * m + 1];
+            for (int m = 0; m < hz; m++) {
+                zr[m] = fr[2 * m];
+                zr[nz - 1 - m] = fr[2 * m + 1];
+            }
         }
     }
     if (!inverse) plane_r2c(t, w);
