@@ -73,17 +73,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* The default planner: FFTW_ESTIMATE, which picks an algorithm from an
- * operation-count estimate without timing anything (the same plans in every
- * run), over the wider set of algorithms FFTW's patient planner considers
- * (FFTW_ESTIMATE_PATIENT, a flag of fftw3.h's "beyond-guru" set; still no
- * timing).  For the 2-D r2c of a 128 x 128 plane plain ESTIMATE takes the
- * scalar straight-line codelet of length 128 along z; with the wider set it
- * takes the SIMD Cooley-Tukey split FFTW_MEASURE also picks: 4.6 -> 2.9 ms
- * for the forward transforms of 128 planes (MEASURE 3.0 ms), 6.9 -> 5.4 ms
- * for the inverse (measured, bench notes in docs/performance.md). */
-#define PLANNER_ESTIMATE (FFTW_ESTIMATE | FFTW_ESTIMATE_PATIENT)
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -1027,11 +1016,11 @@ static void *fft_create(poisson_t *p)
         t->dz.eig = xcalloc(1, sizeof(double));
     }
     if (t->dy.m != t->ny || t->dz.m != t->nz) die("poisson fft: unknown counts disagree with the transforms");
-    t->plan_flags = p->opt.fftw_measure ? FFTW_MEASURE : PLANNER_ESTIMATE;
+    t->plan_flags = p->opt.fftw_measure ? FFTW_MEASURE : FFTW_ESTIMATE;
     /* a plan made during the run (a field of the other alignment class) is
      * not in the wisdom of a measuring run: estimated, hence the same in
      * every run given the same wisdom */
-    t->lazy_flags = PLANNER_ESTIMATE;
+    t->lazy_flags = FFTW_ESTIMATE;
     int nx = t->nx, ny = t->ny, nz = t->nz;
     t->fast = t->dim3 && (t->dy.periodic || (t->dy.neumann && ny % 2 == 0)) &&
               (t->dz.periodic || (t->dz.neumann && nz % 2 == 0));
