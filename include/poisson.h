@@ -102,8 +102,9 @@ int poisson_solve(poisson_t *p, double lambda, const double *b, double *x);
 
 /* The solve in two parts, for a caller that reads x plane by plane
  * (available when poisson_solve_by_planes: the FFT solver on one rank with
- * the transforms by planes: y and z periodic or Neumann): poisson_solve_begin(p, λ, b) does all
- * but writing x; poisson_solve_plane(p, x, i) then writes the unknowns of x
+ * the transforms by planes, y and z each periodic or Neumann):
+ * poisson_solve_begin(p, λ, b) does all but writing x;
+ * poisson_solve_plane(p, x, i) then writes the unknowns of x
  * plane i (every plane once, before the next solve).  Bit-identical to
  * poisson_solve; the ghosts of x are not touched. */
 int poisson_solve_by_planes(const poisson_t *p);

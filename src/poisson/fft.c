@@ -124,13 +124,13 @@ typedef struct {
     long RS, PS;
     step_t fwd[2], inv[2];     /* forward: [0] then [1]; inverse: [0] then [1] */
     int nsteps;
-    int planes;                /* the fast path: 2-D transforms plane by plane through pbuf (plane_transform) */
-    /* fast path: 2-D DFT with Makhoul reordering of the Neumann directions */
+    /* fast path: a 2-D DFT per x plane, with Makhoul reordering of the
+     * Neumann directions */
     int fast, ynn, znn, reord; /* reord = ynn || znn */
     int fused;                 /* butterflies applied inside the tridiagonal sweeps (one rank) */
     double *wy, *wz;           /* twiddles e^{−iπk/2N} (re, im) */
-    /* reordering fast path: the 2-D transforms run plane by plane on a
-     * reordered copy of the plane (pbuf, in cache) */
+    /* fast path: the 2-D transforms run plane by plane on a (reordered)
+     * copy of the plane (pbuf, in cache) */
     double *pbuf;
     fftw_plan pfwd, pinv;
     /* nz even: the plane's r2c as a complex DFT of length nz/2 of each row
@@ -268,11 +268,11 @@ static void step_plan(fft_t *t, step_t *s, int a, unsigned planner)
 
 /* Run step s; f is the field (pointer to its first interior unknown) when a
  * side of the step is the field. */
-static void step_exec(fft_t *t, step_t *s, double *f, double *work)
+static void step_run(fft_t *t, step_t *s, double *f)
 {
     int a = (s->in == SIDE_FIELD || s->out == SIDE_FIELD) ? fftw_alignment_of(f) != 0 : 0;
     if (!s->plan[a]) step_plan(t, s, a, t->lazy_flags);
-    double *side[2] = {f, work};
+    double *side[2] = {f, t->work};
     double *in = side[s->in], *out = side[s->out];
     fftw_plan pl = s->plan[a];
     switch (s->kind) {
@@ -283,11 +283,9 @@ static void step_exec(fft_t *t, step_t *s, double *f, double *work)
     }
 }
 
-static void step_run(fft_t *t, step_t *s, double *f) { step_exec(t, s, f, t->work); }
-
 /* The transform pipeline.
- * Fast path: one 2-D r2c over (y, z) for all x planes when both are
- * periodic; with a Neumann direction, plane by plane (plane_transforms).
+ * Fast path (y and z each periodic or Neumann with an even count): plane by
+ * plane (plane_transforms).
  * General 3-D: z first (field → work; r2c when z is periodic, so its output
  * is complex and the y step is a complex DFT if y is periodic too, else the
  * r2r kind of z), then y in place (r2r kind of y, on every double).  2-D: y
@@ -510,7 +508,7 @@ static void plane_plans(fft_t *t)
 static void plans_make(fft_t *t, int a)
 {
     if (t->nxu == 0) return;
-    if (t->planes) plane_plans(t);
+    if (t->fast) plane_plans(t);
     for (int k = 0; k < t->nsteps; k++) {
         step_plan(t, &t->fwd[k], a, t->plan_flags);
         step_plan(t, &t->inv[k], a, t->plan_flags);
@@ -1027,7 +1025,6 @@ static void *fft_create(poisson_t *p)
     t->ynn = t->fast && t->dy.neumann;
     t->znn = t->fast && t->dz.neumann;
     t->reord = t->ynn || t->znn;
-    t->planes = t->fast;
     t->scale = t->fast ? 1.0 / ((double)ny * nz) : 1.0 / (t->dy.norm * t->dz.norm);
 
     /* shape of a transformed plane and the eigenvalues of its rows/columns */
@@ -1165,8 +1162,8 @@ static void *fft_create(poisson_t *p)
     int a = fftw_alignment_of(f + G_IDX(g, 0, 0, 0)) != 0;
     free(f);
     if (t->nxu > 0) {
-        if (t->planes) t->pbuf = xcalloc((size_t)ny * nz, sizeof(double));
-        t->half = t->planes && nz % 2 == 0;
+        if (t->fast) t->pbuf = xcalloc((size_t)ny * nz, sizeof(double));
+        t->half = t->fast && nz % 2 == 0;
         if (t->half) {
             t->tw = xcalloc((size_t)nz + 2, sizeof(double));
             for (int k = 0; k <= nz / 2; k++) {
@@ -1175,7 +1172,7 @@ static void *fft_create(poisson_t *p)
             }
         }
         setup_steps(t);
-        if (t->planes) t->fwd_ready = xcalloc((size_t)t->nxu, 1);
+        if (t->fast) t->fwd_ready = xcalloc((size_t)t->nxu, 1);
     }
     if (p->opt.fftw_measure)
         plans_measure(t, a);
@@ -1453,7 +1450,7 @@ static void fft_forward_and_modes(fft_t *t, double lambda, const double *b)
     long o = G_IDX(g, 0, 0, 0);
     scratch_attach(t);
     if (t->nxu > 0) {
-        if (t->planes)
+        if (t->fast)
             for (int i = 0; i < t->nxu; i++) {
                 /* a plane poisson_forward_plane transformed ahead is not read again */
                 if (t->fwd_ready[i]) t->fwd_ready[i] = 0;
@@ -1482,7 +1479,7 @@ static int fft_solve(poisson_t *p, void *impl, double lambda, const double *b, d
     fft_forward_and_modes(t, lambda, b);
     if (t->nxu > 0) {
         if (t->reord && !t->fused) fast_butterfly(t, 1);
-        if (t->planes) plane_transforms(t, x + o, 1);
+        if (t->fast) plane_transforms(t, x + o, 1);
         else
             for (int k = 0; k < t->nsteps; k++) step_run(t, &t->inv[k], x + o);
     }
@@ -1515,7 +1512,7 @@ static int fft_by_planes(const poisson_t *p)
 {
     const fft_t *t = p->impl;
     const grid_t *g = p->g;
-    return p->backend == &poisson_backend_fft && t && t->planes && t->P == 1 && t->nxu == g->nxl &&
+    return p->backend == &poisson_backend_fft && t && t->fast && t->P == 1 && t->nxu == g->nxl &&
            t->ny == g->n[1] && t->nz == g->n[2];
 }
 
