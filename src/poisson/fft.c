@@ -77,6 +77,7 @@
 #include <unistd.h>
 
 #include "poisson.h"
+#include "r2r.h"
 #include "util.h"
 
 /* Modes per block of the tridiagonal sweep: the block's data, c' and the
@@ -104,6 +105,7 @@ typedef struct {
     fftw_iodim how[2];         /* loops: x planes, then rows or columns */
     side_t in, out;
     fftw_plan plan[2];         /* per alignment class of the field pointer */
+    r2r_plan_t *cr;            /* TK_R2R: the kind from complex DFTs (r2r.h), used instead of plan */
 } step_t;
 
 typedef struct {
@@ -236,6 +238,11 @@ static step_t step_make(tkind_t kind, fftw_r2r_kind rk, int sign, side_t in, sid
 static void step_plan(fft_t *t, step_t *s, int a, unsigned planner)
 {
     const grid_t *g = t->p->g;
+    /* a real-to-real kind: from complex DFTs where r2r.c covers it (FFTW runs
+     * its r2r kinds with scalar codelets: 2.5-3x slower on 80 lines of 880,
+     * docs/performance.md) */
+    if (s->kind == TK_R2R && s->rank == 1 && !s->cr) s->cr = r2r_plan_make(s->rk, s->dims[0].n, planner);
+    if (s->cr) return;
     double *tmp = NULL, *f = NULL;
     if (s->in == SIDE_FIELD || s->out == SIDE_FIELD) {
         tmp = xcalloc((size_t)g->nalloc + 2, sizeof(double));
@@ -270,6 +277,15 @@ static void step_plan(fft_t *t, step_t *s, int a, unsigned planner)
  * side of the step is the field. */
 static void step_run(fft_t *t, step_t *s, double *f)
 {
+    if (s->cr) {
+        double *side[2] = {f, t->work};
+        int h1 = s->nhow > 1 ? s->how[1].n : 1;
+        long id1 = s->nhow > 1 ? s->how[1].is : 0, od1 = s->nhow > 1 ? s->how[1].os : 0;
+        int h0 = s->nhow > 0 ? s->how[0].n : 1;
+        long id0 = s->nhow > 0 ? s->how[0].is : 0, od0 = s->nhow > 0 ? s->how[0].os : 0;
+        r2r_plan_exec(s->cr, side[s->in], s->dims[0].is, side[s->out], s->dims[0].os, h0, id0, od0, h1, id1, od1);
+        return;
+    }
     int a = (s->in == SIDE_FIELD || s->out == SIDE_FIELD) ? fftw_alignment_of(f) != 0 : 0;
     if (!s->plan[a]) step_plan(t, s, a, t->lazy_flags);
     double *side[2] = {f, t->work};
@@ -523,6 +539,11 @@ static void plans_destroy(fft_t *t)
             if (t->inv[k].plan[a]) fftw_destroy_plan(t->inv[k].plan[a]);
             t->fwd[k].plan[a] = t->inv[k].plan[a] = NULL;
         }
+    for (int k = 0; k < 2; k++) {
+        r2r_plan_destroy(t->fwd[k].cr);
+        r2r_plan_destroy(t->inv[k].cr);
+        t->fwd[k].cr = t->inv[k].cr = NULL;
+    }
     if (t->pfwd) fftw_destroy_plan(t->pfwd);
     if (t->pinv) fftw_destroy_plan(t->pinv);
     t->pfwd = t->pinv = NULL;
