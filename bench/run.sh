@@ -42,6 +42,8 @@ if want fluid; then
 fi
 if want poisson; then
     for np in 1 2; do run poisson_np$np $MPIRUN -np $np "$BUILD/bench/bench_poisson" "$N" 10; done
+    # the r2r kinds from complex DFTs against FFTW's r2r (80 lines of 880: the axisymmetric bounce)
+    run r2r $MPIRUN -np 1 "$BUILD/bench/bench_r2r" 80 880 50
 fi
 if want multigrid; then
     for np in 1 2; do run multigrid_np$np $MPIRUN -np $np "$BUILD/bench/bench_mg" "$N"; done
