@@ -384,12 +384,13 @@ static void split_rows(const fft_t *t, double *w)
             double zkr = x[2 * k], zki = x[2 * k + 1], zjr = x[2 * j], zji = x[2 * j + 1];
             double er = 0.5 * (zkr + zjr), ei = 0.5 * (zki - zji);
             double orr = 0.5 * (zki + zji), oi = -0.5 * (zkr - zjr);
-            double c = tw[2 * k], sn = tw[2 * k + 1];
-            x[2 * k] = er + c * orr - sn * oi;
-            x[2 * k + 1] = ei + c * oi + sn * orr;
+            /* X_k = E_k + W^k O_k, X_{M−k} = conj(E_k) − conj(W^k O_k) (W^M = −1) */
+            double c = tw[2 * k], sn = tw[2 * k + 1], wr = c * orr - sn * oi, wi = c * oi + sn * orr;
+            x[2 * k] = er + wr;
+            x[2 * k + 1] = ei + wi;
             if (j != k) {
-                x[2 * j] = er - c * orr + sn * oi;
-                x[2 * j + 1] = -ei + c * oi + sn * orr;
+                x[2 * j] = er - wr;
+                x[2 * j + 1] = wi - ei;
             }
         }
     }
@@ -409,14 +410,13 @@ static void merge_rows(const fft_t *t, double *w)
             double xkr = x[2 * k], xki = x[2 * k + 1], xjr = x[2 * j], xji = x[2 * j + 1];
             double er = xkr + xjr, ei = xki - xji, dr = xkr - xjr, di = xki + xji;
             double c = tw[2 * k], sn = tw[2 * k + 1];
-            /* O_k = conj(W^k) D_k, O_j = −W^k conj(D_k) */
+            /* O_k = conj(W^k) D_k and O_{M−k} = conj(O_k); Z = E + iO */
             double okr = c * dr + sn * di, oki = c * di - sn * dr;
             x[2 * k] = er - oki;
             x[2 * k + 1] = ei + okr;
             if (j != k) {
-                double ojr = c * dr + sn * di, oji = -c * di + sn * dr;
-                x[2 * j] = er - oji;
-                x[2 * j + 1] = -ei + ojr;
+                x[2 * j] = er + oki;
+                x[2 * j + 1] = okr - ei;
             }
         }
     }
