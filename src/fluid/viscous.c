@@ -126,14 +126,13 @@ void fluid_wall_terms_add(const fluid_t *f, int c, double scale, double *out)
     const fluid_priv_t *q = fluid_priv(f);
     const poisson_t *p = q->pv[c];
     int iend = fluid_iend(g, c), nj = fluid_nu(g, c, 1), nk = fluid_nu(g, c, 2), nx = g->n[0];
-    /* walls at rest (the common case): every term is 0, and out += scale · 0
-     * with the caller's scale −1 adds −0, which changes no value: nothing to
-     * do (this loop over every cell was 15 % of the axisymmetric bounce) */
+    /* walls at rest (the common case): every term below is 0, nothing to add
+     * (this loop over every cell was 15 % of the axisymmetric bounce) */
     int moving = q->xwall[c][0] != 0.0 || q->xwall[c][1] != 0.0;
     for (int d = 1; d < g->dim; d++)
         for (int s = 0; s < 2; s++)
             moving |= d != c && !g->periodic[d] && g->bc.type[d][s] == BC_NOSLIP && g->bc.vel[d][s][c] != 0.0;
-    if (!moving && scale < 0.0) return;
+    if (!moving) return;
     for (int i = 0; i < iend; i++) {
         int ig = i + g->ix0;
         double wx = (ig == 0 ? q->xwall[c][0] : 0.0) + (ig == nx - 1 ? q->xwall[c][1] : 0.0);
