@@ -239,8 +239,8 @@ static void step_plan(fft_t *t, step_t *s, int a, unsigned planner)
 {
     const grid_t *g = t->p->g;
     /* a real-to-real kind: from complex DFTs where r2r.c covers it (FFTW runs
-     * its r2r kinds with scalar codelets: 2.5-3x slower on 80 lines of 880,
-     * docs/performance.md) */
+     * its r2r kinds with scalar codelets: 2.4-3.1x slower on 80 lines of 880,
+     * bench_r2r) */
     if (s->kind == TK_R2R && s->rank == 1 && !s->cr) s->cr = r2r_plan_make(s->rk, s->dims[0].n, planner);
     if (s->cr) return;
     double *tmp = NULL, *f = NULL;

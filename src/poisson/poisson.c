@@ -18,8 +18,8 @@ static const cfg_key_t poisson_keys[] = {
     {"poisson", "mg_pre", CFG_INT, "2", 0, 20, NULL, "multigrid: pre-smoothing sweeps"},
     {"poisson", "mg_post", CFG_INT, "2", 0, 20, NULL, "multigrid: post-smoothing sweeps"},
     {"poisson", "fftw_planner", CFG_ENUM, "estimate", 1, 0, "estimate|measure",
-     "fft: FFTW planner; measure times candidate algorithms at start-up (at 128^3 the solve is within 0-3 % of "
-     "estimate's, docs/performance.md); its choices "
+     "fft: FFTW planner; measure times candidate algorithms at start-up (at 128^3 the solve is 0-3 % faster "
+     "than estimate's on 1 rank, 12-16 % on 2, docs/performance.md); its choices "
      "are kept as FFTW wisdom in the checkpoints and OUT/fftw.wisdom, so restarts are exact, and runs are "
      "bit-identical to each other when they share a wisdom file (fftw_wisdom)"},
     {"poisson", "fftw_wisdom", CFG_STRING, "none", 1, 0, NULL,
