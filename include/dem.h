@@ -127,9 +127,12 @@ static inline int dem_in_contact(const dem_t *d, int i)
 void dem_lubrication_register_keys(void);
 /* Lubrication force on each particle in the last step (impulse / dt), 3n. */
 const double *dem_lubrication_forces(const dem_t *d);
-/* Time until the first particle–particle or particle–wall contact at the
- * current velocities (0: a contact exists; INFINITY: nothing approaches). */
-double dem_time_to_contact(const dem_t *d);
+/* Time until the first particle–particle or particle–wall contact (0: a
+ * contact exists; INFINITY: nothing approaches): at the current velocities,
+ * or, for lubricated pairs whose constant-velocity estimate is below
+ * `horizon`, along the lubricated approach with gravity and the held external
+ * forces (dem_lub_approach_time in lubrication.c). */
+double dem_time_to_contact(const dem_t *d, double horizon);
 /* A function called after every DEM step (NULL: none), e.g. to record the
  * motion at the resolution of the sub-steps. */
 void dem_set_step_observer(dem_t *d, void (*fn)(dem_t *d, void *ctx), void *ctx);

@@ -7,10 +7,11 @@
  *   V_T  the largest approach speed before the first contact, over the fluid
  *        steps ("the terminal velocity before any wall influence");
  *   V_C  the approach speed at the last fluid step before the contact (the
- *        seed's velocity histories are sampled at the fluid steps); the
- *        speed at the last sub-step before the contact, V_C_onset, is lower
- *        by the lubrication of the last fraction of the gap (up to a fluid
- *        step's displacement), ∝ ln of that gap over η_e;
+ *        seed's velocity histories are sampled at the fluid steps; with
+ *        aligned contacts that step ends t_c/8 before the contact, see
+ *        docs/theory.md §9.1); the speed at the last sub-step before the
+ *        contact, V_C_onset, is lower by the lubrication of the last
+ *        fraction of the gap, ∝ ln of that gap over η_e;
  *   V_R  the largest rebound speed −u after the contact, over the fluid
  *        steps until the next contact ("the maximum value of the velocity of
  *        opposite sign just after detachment": the seed's velocity history

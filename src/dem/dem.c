@@ -707,31 +707,72 @@ void dem_diag_light(dem_t *d, dem_diag_t *o)
     if (d->split) MPI_Allreduce(MPI_IN_PLACE, &o->contacts_started, 1, MPI_LONG, MPI_SUM, d->comm);
 }
 
-double dem_time_to_contact(const dem_t *d)
+/* Acceleration of particle i between contacts: gravity and the external
+ * (held hydrodynamic) force. */
+static void free_acceleration(const dem_t *d, int i, double acc[3])
+{
+    for (int a = 0; a < 3; a++)
+        acc[a] = d->fixed[i] ? 0.0 : d->gravity[a] + (d->use_ext ? d->fext[3 * i + a] * d->invm[i] : 0.0);
+}
+
+/* The time for a gap to close: at constant velocity, or, when the pair is
+ * lubricated and the constant-velocity estimate is within `horizon`, along
+ * the lubricated approach with the pair's free acceleration
+ * (dem_lub_approach_time), whose slow-down the constant velocity misses.
+ * Without acceleration towards contact the lubricated time is at least gap/u,
+ * so a pair whose gap/u is already above `best` is not integrated. */
+static double closing_time(const dem_t *d, int lub, double R, double reff, double m, double gap, double u, double a,
+                           double horizon, double best)
+{
+    if (!lub) return u > 0 ? gap / u : INFINITY;
+    if (u > 0 && (gap / u > horizon || (a <= 0 && gap / u >= best))) return gap / u; /* not the first contact */
+    if (u <= 0 && a <= 0) return INFINITY;
+    return u > 0 ? dem_lub_approach_time(d, R, reff, m, gap, u, a) : INFINITY;
+}
+
+double dem_time_to_contact(const dem_t *d, double horizon)
 {
     /* pairs from the neighbour lists (every pair that can touch before the next rebuild),
-     * walls directly; the relative velocity is held */
+     * walls directly; the minimum over the ranks of a split DEM */
     double tmin = INFINITY;
+    const int lub = d->lub.on;
     if (d->nb_start)
         for (int i = 0; i < d->nb_n_rows; i++)
             for (long e = d->nb_start[i]; e < d->nb_start[i + 1]; e++) {
                 const int j = d->nb_j[e];
-                double n[3];
+                double n[3], ai[3], aj[3];
                 const double gap = dem_pair_normal(d, i, e, n) - d->r[i] - d->r[j];
-                if (gap <= 0) return 0.0;
+                if (gap <= 0) {
+                    tmin = 0.0;
+                    goto reduce;
+                }
                 const double u = dem_pair_approach(d, i, j, n);
-                if (u > 0 && gap / u < tmin) tmin = gap / u;
+                if (d->invm[i] == 0 && d->invm[j] == 0) continue;
+                free_acceleration(d, i, ai);
+                free_acceleration(d, j, aj);
+                const double a = (ai[0] - aj[0]) * n[0] + (ai[1] - aj[1]) * n[1] + (ai[2] - aj[2]) * n[2];
+                const double R = d->r[i] < d->r[j] ? d->r[i] : d->r[j], reff = d->r[i] * d->r[j] / (d->r[i] + d->r[j]);
+                const double t = closing_time(d, lub, R, reff, 1.0 / (d->invm[i] + d->invm[j]), gap, u, a, horizon, tmin);
+                if (t < tmin) tmin = t;
             }
     for (int w = 0; w < d->nwall; w++) {
         const dem_wall_t *W = &d->wall[w];
         if (!W->active) continue;
         for (int i = 0; i < d->n; i++) {
             if (d->fixed[i]) continue;
-            double u;
+            double u, acc[3];
             const double gap = dem_wall_gap(d, W, i, &u);
-            if (gap <= 0) return 0.0;
-            if (u > 0 && gap / u < tmin) tmin = gap / u;
+            if (gap <= 0) {
+                tmin = 0.0;
+                goto reduce;
+            }
+            free_acceleration(d, i, acc);
+            const double a = -(acc[0] * W->n[0] + acc[1] * W->n[1] + acc[2] * W->n[2]);
+            const double t = closing_time(d, lub && d->lub.walls, d->r[i], d->r[i], 1.0 / d->invm[i], gap, u, a, horizon, tmin);
+            if (t < tmin) tmin = t;
         }
     }
+reduce: /* a split DEM: every rank must take the same fluid step */
+    if (d->split) MPI_Allreduce(MPI_IN_PLACE, &tmin, 1, MPI_DOUBLE, MPI_MIN, d->comm);
     return tmin;
 }

@@ -230,6 +230,10 @@ void dem_lubrication_config(dem_t *d, cfg_t *cfg);
 /* Apply the lubrication impulses of the coming drift of length dt to the
  * half-step velocities (implicit in the gap, see lubrication.c). */
 void dem_lubrication_impulses(dem_t *d, double dt);
+/* Time for a lone pair (radius R for η_e and Δ_lub, R_eff, mass m) to close
+ * gap0 from approach speed u0 with approach acceleration a under the
+ * lubrication (INFINITY: it stops first). */
+double dem_lub_approach_time(const dem_t *d, double R, double reff, double m, double gap0, double u0, double a);
 
 /* ---- pair and wall geometry for the passes outside the force kernel ---- */
 /* Unit normal n from particle i to the partner of its list entry e (the

@@ -123,6 +123,53 @@ static inline void lub_params(const dem_lub_t *L, double R, lub_pair_t *p)
     p->overlap = L->overlap;
 }
 
+/* Time for a lone pair to close its gap from gap0 to 0, at approach speed u0
+ * and a constant approach acceleration a (gravity and the held external
+ * forces), under the lubrication of the header: the motion keeps
+ *     u − (k/m) L(δ) = u0 − (k/m) L(gap0) + a t
+ * (the first integral of the header with a added), so t(δ) obeys
+ *     dt/ds = (δ + η_e)/u,   s = ln(δ + η_e) decreasing,  u = w0 + a t + (k/m) L(δ),
+ * integrated by RK4 in s, which resolves the logarithmic slow-down of the last
+ * η_e's: 48 steps from gap0 down to Δ_lub (L constant there) and 48 from Δ_lub
+ * (or gap0) down to 0.  INFINITY when the approach stops (u ≤ 0) before the
+ * gap closes: the pair does not touch.  Used to align the fluid steps with
+ * the contacts (dem_time_to_contact): the constant-velocity estimate gap0/u0
+ * is early by the whole slow-down, up to several fluid steps at low St. */
+static double lub_approach_time(const lub_pair_t *p, double m, double k, double gap0, double u0, double a)
+{
+    const double w0 = u0 - k / m * lub_potential(p, gap0), eta = p->eta;
+    const double ends[3] = {gap0, gap0 > p->range ? p->range : gap0, 0.0};
+    double t = 0.0;
+    for (int seg = 0; seg < 2; seg++) {
+        if (ends[seg] <= ends[seg + 1]) continue;
+        const int N = 48;
+        const double s0 = log(ends[seg] + eta), h = (s0 - log(ends[seg + 1] + eta)) / N;
+        /* dt/dσ with σ = s0 − s increasing; u at the gap e^s − η_e */
+        double s = s0;
+        for (int q = 0; q < N; q++) {
+            double kk[4], tt = t;
+            for (int r = 0; r < 4; r++) {
+                const double sr = s - (r == 0 ? 0.0 : r == 3 ? h : 0.5 * h);
+                const double delta = fmax(exp(sr) - eta, 0.0);
+                const double u = w0 + a * tt + k / m * lub_potential(p, delta);
+                if (!(u > 0)) return INFINITY;
+                kk[r] = (delta + eta) / u;
+                tt = t + (r == 2 ? h : 0.5 * h) * kk[r];
+            }
+            t += h / 6.0 * (kk[0] + 2.0 * kk[1] + 2.0 * kk[2] + kk[3]);
+            s -= h;
+        }
+    }
+    return t;
+}
+
+double dem_lub_approach_time(const dem_t *d, double R, double reff, double m, double gap0, double u0, double a)
+{
+    lub_pair_t p;
+    lub_params(&d->lub, R, &p);
+    return lub_approach_time(&p, m, 6.0 * M_PI * d->lub.viscosity * reff * reff, gap0, u0, a);
+}
+
 void dem_lubrication_impulses(dem_t *d, double dt)
 {
     const dem_lub_t *L = &d->lub;
