@@ -716,18 +716,22 @@ static void free_acceleration(const dem_t *d, int i, double acc[3])
 }
 
 /* The time for a gap to close: at constant velocity, or, when the pair is
- * lubricated and the constant-velocity estimate is within `horizon`, along
- * the lubricated approach with the pair's free acceleration
- * (dem_lub_approach_time), whose slow-down the constant velocity misses.
- * Without acceleration towards contact the lubricated time is at least gap/u,
- * so a pair whose gap/u is already above `best` is not integrated. */
+ * lubricated, along the lubricated approach with the pair's free
+ * acceleration a (dem_lub_approach_time), whose slow-down the constant
+ * velocity misses.  The lubrication only slows the approach, so the time
+ * without it, t₀ (u t + a t²/2 = gap), is a lower bound: a pair whose t₀ is
+ * beyond `horizon` or not below `best` (the earliest contact found so far)
+ * is not integrated. */
 static double closing_time(const dem_t *d, int lub, double R, double reff, double m, double gap, double u, double a,
                            double horizon, double best)
 {
     if (!lub) return u > 0 ? gap / u : INFINITY;
-    if (u > 0 && (gap / u > horizon || (a <= 0 && gap / u >= best))) return gap / u; /* not the first contact */
     if (u <= 0 && a <= 0) return INFINITY;
-    return u > 0 ? dem_lub_approach_time(d, R, reff, m, gap, u, a) : INFINITY;
+    const double disc = u * u + 2.0 * a * gap;
+    if (disc < 0) return INFINITY; /* decelerated to rest before the gap closes, even without lubrication */
+    const double t0 = 2.0 * gap / (u + sqrt(disc)); /* the root of u t + a t²/2 = gap, without cancellation */
+    if (t0 > horizon || t0 >= best) return t0; /* not the first contact within the horizon */
+    return dem_lub_approach_time(d, R, reff, m, gap, u, a);
 }
 
 double dem_time_to_contact(const dem_t *d, double horizon)
