@@ -128,10 +128,11 @@ void dem_lubrication_register_keys(void);
 /* Lubrication force on each particle in the last step (impulse / dt), 3n. */
 const double *dem_lubrication_forces(const dem_t *d);
 /* Time until the first particle–particle or particle–wall contact (0: a
- * contact exists; INFINITY: nothing approaches): at the current velocities,
- * or, for lubricated pairs whose constant-velocity estimate is below
- * `horizon`, along the lubricated approach with gravity and the held external
- * forces (dem_lub_approach_time in lubrication.c). */
+ * contact exists; INFINITY: nothing approaches).  Without lubrication at the
+ * current velocities; lubricated pairs along their lubricated approach with
+ * gravity and the held external forces (dem_lub_approach_time in
+ * lubrication.c), except where a lower bound (the time without lubrication)
+ * is beyond `horizon`: that bound is returned for them. */
 double dem_time_to_contact(const dem_t *d, double horizon);
 /* A function called after every DEM step (NULL: none), e.g. to record the
  * motion at the resolution of the sub-steps. */

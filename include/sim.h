@@ -36,6 +36,9 @@ typedef struct sim_part {
     void *ctx;
     /* Largest stable time step (INFINITY if the part sets no limit). */
     double (*stable_dt)(void *ctx);
+    /* Optional: given the step dt every part's limit allows, the step to take
+     * (no longer than dt), e.g. one that ends where a collision starts. */
+    double (*align_dt)(void *ctx, double dt);
     /* Advance by dt from the current state. */
     void (*advance)(void *ctx, double dt);
     /* Columns this part adds to the time series, and their values after a

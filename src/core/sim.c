@@ -241,6 +241,8 @@ static double stable_dt(sim_t *s)
     double dt = INFINITY;
     for (int i = 0; i < s->npart; i++)
         if (s->part[i].stable_dt) dt = fmin(dt, s->part[i].stable_dt(s->part[i].ctx));
+    for (int i = 0; i < s->npart; i++)
+        if (s->part[i].align_dt) dt = fmin(dt, s->part[i].align_dt(s->part[i].ctx, dt));
     /* Land on t_end: a last step shortened (or slightly stretched, by less
      * than 1e-9 dt) rather than a sliver of a step after it. */
     if (s->time + dt * (1.0 + 1e-9) >= s->prm.t_end) dt = s->prm.t_end - s->time;

@@ -118,31 +118,30 @@ static void setup(coupling_part_t *cp)
     }
 }
 
-/* align_contacts: the step ends where the next contact is predicted to
- * start, unless that is less than t_c/4 away.  The prediction follows the
- * lubricated approach (dem_time_to_contact) for the pairs whose
- * constant-velocity estimate is within four of the last fluid steps.  A
- * contact predicted just beyond the regular step T (the fluid's and the
- * spheres' limits), between T and 1.5 T, would leave a sliver of a step
- * before it, whose hydrodynamic force (a change of the fluid momentum over a
- * tiny Δt) is noise: the distance is split into two equal steps instead.
- * The aim is t_c/8 before the predicted contact (see below). */
-static double part_stable_dt(void *ctx)
+/* align_contacts: given the step T that the fluid and the spheres allow, the
+ * step ends t_c/8 before the next contact is predicted to start, unless that
+ * is less than t_c/4 away (it starts early in the next step anyway).  The
+ * prediction follows the lubricated approach (dem_time_to_contact), which
+ * the constant-velocity estimate gap/u misses.  A contact predicted just
+ * beyond T, between T and 1.5 T, would leave a sliver of a step before it,
+ * whose hydrodynamic force (a change of the fluid momentum over a tiny Δt) is
+ * noise: the distance is split into two equal steps instead.  The aim is
+ * t_c/8 early because the prediction holds the last hydrodynamic force, which
+ * grows as the gap closes (the film the grid resolves): it is late by a few
+ * sub-steps.  Only the step's own state enters (no previous step): a restart
+ * takes the same steps. */
+static double part_align_dt(void *ctx, double T)
 {
     coupling_part_t *cp = ctx;
     setup(cp);
-    if (!cp->ibm || !cp->align) return INFINITY;
-    const double dt_last = cp->sim->dt;
-    const double t = dem_time_to_contact(cp->d, dt_last > 0 ? 4.0 * dt_last : INFINITY);
-    if (t <= 0) return INFINITY; /* in contact: the fluid stays frozen over a whole step */
+    if (!cp->ibm || !cp->align) return T;
     const double tmin = 0.25 * dem_contact_time(cp->d);
-    if (!(t > tmin)) return INFINITY; /* it starts early in the next step anyway */
-    const fluid_t *f = cp->ibm->f;
-    const double T = fmin(f->prm.dt_fixed > 0 ? f->prm.dt_fixed : fluid_stable_dt(f), ibm_stable_dt(cp->ibm, f->prm.cfl));
-    /* aim t_c/8 early: the prediction holds the last hydrodynamic force, which grows
-     * as the gap closes (the film the grid resolves), so it is late by a few sub-steps */
+    /* contacts beyond 1.5 T + t_c/8 cannot change the step: not integrated */
+    const double t = dem_time_to_contact(cp->d, 1.5 * T + 0.5 * tmin);
+    if (!(t > tmin)) return T; /* in contact (the fluid stays frozen over a whole step), or about to be */
     const double aim = t - 0.5 * tmin;
-    return aim > T && aim < 1.5 * T ? 0.5 * aim : aim;
+    if (aim >= 1.5 * T) return T;
+    return aim > T ? 0.5 * aim : aim;
 }
 
 static void part_advance(void *ctx, double dt)
@@ -319,7 +318,7 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
     sim_part_t part = {
         .name = "coupling",
         .ctx = cp,
-        .stable_dt = part_stable_dt,
+        .align_dt = part_align_dt,
         .advance = part_advance,
         .ncol = mode ? 2 : 0,
         .col_names = rest_cols,
