@@ -3,7 +3,7 @@
 #   make test       install missing Debian packages, build, run the test suite (1 and 2 ranks)
 #   make demo       install, build, run the built-in demo case and plot it
 #   make validate   full-size validation cases (long)
-#   make restitution  restitution sweeps of issue 5 (wall and binary; 1.4 min on 2 cores, measured in session 7);
+#   make restitution  restitution sweeps of issue 5 (wall and binary; 1.3 min on 2 cores, measured in session 8);
 #                   RESTITUTION_SET='section.key=value ...' overrides keys in every run,
 #                   RESTITUTION_OUT=dir the output directory (default build/restitution)
 #   make bench      benchmarks, results appended to docs/performance.md
