@@ -725,8 +725,8 @@ static void free_acceleration(const dem_t *d, int i, double acc[3])
 static double closing_time(const dem_t *d, int lub, double R, double reff, double m, double gap, double u, double a,
                            double horizon, double best)
 {
-    if (!lub) return u > 0 ? gap / u : INFINITY;
-    if (u <= 0 && a <= 0) return INFINITY;
+    if (u <= 0) return INFINITY; /* not approaching now: a later step predicts its contact */
+    if (!lub) return gap / u;
     const double disc = u * u + 2.0 * a * gap;
     if (disc < 0) return INFINITY; /* decelerated to rest before the gap closes, even without lubrication */
     const double t0 = 2.0 * gap / (u + sqrt(disc)); /* the root of u t + a t²/2 = gap, without cancellation */
