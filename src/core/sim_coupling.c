@@ -135,11 +135,11 @@ static double part_align_dt(void *ctx, double T)
     coupling_part_t *cp = ctx;
     setup(cp);
     if (!cp->ibm || !cp->align) return T;
-    const double tmin = 0.25 * dem_contact_time(cp->d);
+    const double margin = 0.125 * dem_contact_time(cp->d); /* t_c/8 */
     /* contacts beyond 1.5 T + t_c/8 cannot change the step: not integrated */
-    const double t = dem_time_to_contact(cp->d, 1.5 * T + 0.5 * tmin);
-    if (!(t > tmin)) return T; /* in contact (the fluid stays frozen over a whole step), or about to be */
-    const double aim = t - 0.5 * tmin;
+    const double t = dem_time_to_contact(cp->d, 1.5 * T + margin);
+    if (!(t > 2.0 * margin)) return T; /* in contact (the fluid stays frozen over a whole step), or within t_c/4 */
+    const double aim = t - margin;
     if (aim >= 1.5 * T) return T;
     return aim > T ? 0.5 * aim : aim;
 }
