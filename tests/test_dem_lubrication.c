@@ -453,7 +453,7 @@ static void test_time_to_contact(void **state)
          * begins: its onset lies 0-2 of its steps after the exact time (measured 1.26) */
         assert_true(fabs(t / tref - 1) < 1e-5);
         assert_true(t_dem >= t && t_dem - t < 2.0 * TC / nc);
-        /* the constant-velocity estimate misses the slow-down: 9 % early here, 75 DEM steps */
+        /* the constant-velocity estimate misses the slow-down: 9 % early here, 378 DEM steps */
         assert_true(gap0 / u0 < 0.95 * t);
         dem_free(d);
         /* 2. St = 5 < ΔL: the approach stops, no contact */
