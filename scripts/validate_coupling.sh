@@ -63,10 +63,9 @@ for v in "1e-5 0.5" "2e-4 0.5" "1e-3 0.5" "2e-4 1"; do
 done
 wait
 /usr/bin/python3 - "$OUT" <<'PY' || rc=1
-import json, math, sys
-def model(st, r):  # Izard eq. 3.30 with beta of eq. 3.25
-    b = 1 + math.log(r) / st
-    return 0.0 if b <= 0 else b * math.exp(-(math.pi / 2) / math.sqrt(b * st))
+import json, sys
+sys.path.insert(0, "postproc")
+from restitution import model_330 as model  # Izard eq. 3.30 with beta of eq. 3.25
 seed = {("1e-5", "0.5"): "0.59", ("2e-4", "0.5"): "-", ("1e-3", "0.5"): "0.67", ("2e-4", "1"): "0.63"}
 print("  Table 3.2 at St ~ 55: eta_e/R, Delta_lub/R, eps/eps_max, seed, model (3.30), V_C_onset/V_T")
 for (r, rng), sv in seed.items():
