@@ -36,6 +36,7 @@
 #ifndef IBMDEM_PORENET_H
 #define IBMDEM_PORENET_H
 
+#include <hdf5.h>
 #include <stddef.h>
 
 /* Flow boundary condition of a wall face (face f = 2*axis + side, side 0 = lo). */
@@ -158,6 +159,9 @@ void pn_solver_free(pn_solver_t *s);
  * skeleton) and the domain's boundary values.  Returns 0, or -1 if PCG did not
  * converge. */
 int pn_solve(pn_solver_t *s, const pn_domain_t *dom, const pn_net_t *net, const double *dvdt, double *p);
+/* The unknowns' values of the last solve (the PCG's starting guess of the
+ * next one) set from pore pressures p (a restart continues as the run). */
+void pn_solver_set_solution(pn_solver_t *s, const double *p, int npore);
 /* Iterations of the last PCG solve (0 for CHOLMOD); time of the factorisation. */
 int pn_solver_iterations(const pn_solver_t *s);
 double pn_solver_factor_time(const pn_solver_t *s);
@@ -200,6 +204,7 @@ typedef struct {
     pn_solver_t *sol;
     int built;
     double *p, *vol, *vol_prev, *dvdt, *x_prev;
+    double *x_tri;      /* positions the current triangulation and network were built for (checkpoints) */
     int vol_current;    /* vol holds the pore volumes at x_prev on the current topology (the next step's start) */
     double *f, *fp, *fv; /* fp, fv: filled by pn_write_snapshot only */
     double *x_cont;     /* previous positions continuous with the current ones (periodic unwrapping) */
@@ -230,6 +235,17 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r);
  * Re-triangulates when due, solves, computes m->f.  0 or -1 (m->err). */
 int pn_model_step(pn_model_t *m, int n, const double *x, const double *r, double dt);
 void pn_model_free(pn_model_t *m);
+/* The model's exact state in an HDF5 group of a checkpoint (state.c): the
+ * positions of the last triangulation, the previous positions and pore
+ * volumes, the strain accumulated since the triangulation, the pressures,
+ * the forces and the snapshot index.  pn_model_state_read rebuilds the
+ * triangulation from the saved positions (the same network and
+ * factorisation) and restores the rest, so that the next step is the one of
+ * the run that wrote it; r: the radii (n spheres, in the model's order).
+ * network = 0: the snapshot index only (a fixed packing, solved once).
+ * 0, or -1 with m->err. */
+int pn_model_state_write(const pn_model_t *m, hid_t group);
+int pn_model_state_read(pn_model_t *m, hid_t group, int n, const double *r, int network);
 
 /* ---- coupling with the DEM engine (couple.c) ------------------------------------- */
 
@@ -242,6 +258,13 @@ struct dem;
  * pressures; the model's forces act through the centres: zero torque).
  * dt <= 0: rigid skeleton (the initial state).  0 or -1 (m->err). */
 int pn_model_couple_dem(pn_model_t *m, struct dem *d, const double g[3], double dt);
+/* The fluid force of the last step (m->f) plus the buoyancy −ρ_f V g into
+ * dem_ext_force() (the second half of pn_model_couple_dem; a restart applies
+ * the saved forces with it). */
+void pn_model_apply_forces(const pn_model_t *m, struct dem *d, const double g[3]);
+/* m->xid, m->rid: the DEM's positions and radii in the order of the
+ * particle ids (the first half of pn_model_couple_dem). */
+void pn_model_gather(pn_model_t *m, const struct dem *d);
 /* Time-step limit of the coupled problem, ζ · min_k Δt_{M−V} with the viscous
  * limit of each mobile particle Δt_{M−V} = π ρ_k d_k²/(1200 μ) = M_k/(200 μ d_k)
  * (thesis 4.19–4.22, β = 400 calibrated for d_max/d_min ≤ 10). */

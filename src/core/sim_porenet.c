@@ -202,6 +202,36 @@ static void part_write_fields(void *ctx, double time, long step)
     pn_write_snapshot(&pp->m, pp->x, pp->sim->out.dir, time);
 }
 
+static void part_checkpoint_write(void *ctx, hid_t g)
+{
+    porenet_part_t *pp = ctx;
+    ensure_started(pp);
+    pn_model_state_write(&pp->m, g);
+}
+
+/* The state of the run that wrote the checkpoint (state.c): with DEM
+ * particles, the triangulation of its last rebuild, the strain accumulated
+ * since, the previous positions and volumes, the pressures and the forces
+ * the DEM holds in its next step; the snapshot index in every case. */
+static void part_checkpoint_read(void *ctx, hid_t g, const char *path)
+{
+    porenet_part_t *pp = ctx;
+    if (pp->with_dem) {
+        pp->started = 1;
+        pp->d = sim_dem_engine(pp->sim);
+        pn_model_gather(&pp->m, pp->d);
+        if (pn_model_state_read(&pp->m, g, dem_count(pp->d), pp->m.rid, 1)) die("%s: porenet: %s", path, pp->m.err);
+        if (!pp->m.built) die("%s: porenet: the checkpoint holds no network", path);
+        pn_model_apply_forces(&pp->m, pp->d, pp->g);
+        pp->n = pp->m.n;
+        pp->x = pp->m.xid;
+        pp->r = pp->m.rid;
+        after_solve(pp);
+    } else if (pn_model_state_read(&pp->m, g, pp->n, pp->r, 0)) {
+        die("%s: porenet: %s", path, pp->m.err);
+    }
+}
+
 static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
 {
     porenet_part_t *pp = ctx;
@@ -282,6 +312,8 @@ void sim_add_porenet(sim_t *s, cfg_t *cfg)
         .diagnostics = part_diagnostics,
         .diverged = part_diverged,
         .write_fields = part_write_fields,
+        .checkpoint_write = part_checkpoint_write,
+        .checkpoint_read = part_checkpoint_read,
         .summary = part_summary,
         .destroy = part_destroy,
     };

@@ -43,6 +43,12 @@ struct pn_solver {
 };
 
 int pn_solver_iterations(const pn_solver_t *s) { return s->iters; }
+
+void pn_solver_set_solution(pn_solver_t *s, const double *p, int npore)
+{
+    for (int i = 0; i < npore; i++)
+        if (s->unk[i] >= 0) s->x[s->unk[i]] = p[i];
+}
 double pn_solver_factor_time(const pn_solver_t *s) { return s->t_factor; }
 
 void pn_solver_free(pn_solver_t *s)
