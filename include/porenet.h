@@ -70,12 +70,16 @@ typedef struct {
     double *cond;       /* conditioning of each power-centre solve (|det| relative to the scale³; 0: hyperplane) */
     int *grp;           /* qhull facet the tetrahedron was split from (Qt: co-spherical set), or -1 */
     double margin;      /* width of the image layer */
+    double margin_needed; /* the width the tetrahedra of the box need (≤ margin) */
     int n_flat;         /* lower facets whose tetrahedron is flat (power centre from the hyperplane) */
 } pn_tri_t;
 
 /* Regular triangulation of n spheres (x: 3n, r: n) in the domain.  Returns 0,
  * or -1 with a reason in err (a centre inside another sphere or outside the
- * box, qhull failure).  margin <= 0: 3 maximum diameters. */
+ * box, qhull failure).  The image layer is `margin` wide (<= 0: 2.5 maximum
+ * radii), widened when the tetrahedra of the box need more, up to 6 maximum
+ * radii or `margin` (t->margin: the width used; t->margin_needed <= t->margin:
+ * every pore of the box is exact). */
 int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double *r, double margin, pn_tri_t *t,
                    char *err, size_t nerr);
 void pn_tri_free(pn_tri_t *t);
@@ -197,6 +201,8 @@ typedef struct {
     double pcg_tol;
     double eps_retri;   /* re-triangulate when Σ_steps max_i |ΔV_i/V_i| exceeds this (thesis 5.13–5.14); 0: every step */
     double margin;      /* image layer (0: auto) */
+    int margin_warned;  /* warned once: 1 the given margin was widened, 2 some pores need more than the widest */
+    double margin_used; /* the width of the last triangulation (the next one starts from it) */
     double rho_f;       /* fluid density (Reynolds number, buoyancy) */
     int n;
     pn_tri_t tri;
@@ -242,10 +248,9 @@ void pn_model_free(pn_model_t *m);
  * triangulation from the saved positions (the same network and
  * factorisation) and restores the rest, so that the next step is the one of
  * the run that wrote it; r: the radii (n spheres, in the model's order).
- * network = 0: the snapshot index only (a fixed packing, solved once).
  * 0, or -1 with m->err. */
 int pn_model_state_write(const pn_model_t *m, hid_t group);
-int pn_model_state_read(pn_model_t *m, hid_t group, int n, const double *r, int network);
+int pn_model_state_read(pn_model_t *m, hid_t group, int n, const double *r);
 
 /* ---- coupling with the DEM engine (couple.c) ------------------------------------- */
 

@@ -35,8 +35,12 @@ static const cfg_key_t porenet_keys[] = {
     {"porenet", "dem_steps", CFG_INT, "1", 1, 1000, NULL,
      "with DEM particles: DEM steps per coupled step (multi-rate: the pressures are solved and the fluid forces "
      "updated every dem_steps DEM steps); the coupled step stays within dt_factor x the viscous limit"},
+    {"porenet", "snapshots", CFG_ENUM, "auto", 1, 0, "auto|on|off",
+     "network snapshots (porenet_NNNNN.h5 + porenet.xmf, at the run's snapshot times): auto = with DEM particles "
+     "only (a fixed packing is solved once: its results are in summary.json), on, off"},
     {"porenet", "margin", CFG_DOUBLE, "0", 0, BIG, NULL,
-     "width of the layer of sphere images across the faces (m); 0: 3 largest diameters"},
+     "width of the layer of sphere images across the faces (m); 0: 2.5 largest radii; widened (with a warning "
+     "when given) to what the pores of the box need: a narrower layer would lose or change pores"},
     {"porenet", "packing", CFG_STRING, NULL, 1, 0, NULL,
      "fixed packing when the scene has no DEM particles ([particles]): text (x y z r per line, # comments) "
      "or HDF5 (.h5: datasets position [n][3] and radius, the layout of ibm.spheres_file)"},

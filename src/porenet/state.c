@@ -34,6 +34,9 @@ int pn_model_state_write(const pn_model_t *m, hid_t g)
     io_h5_attr_long(g, "steps", m->n_steps);
     io_h5_attr_long(g, "volumes_current", m->vol_current);
     io_h5_attr_double(g, "strain_accumulated", m->eps_acc);
+    io_h5_attr_double(g, "margin_used", m->margin_used);
+    io_h5_write_array(g, "domain_lo", 3, m->dom.lo);
+    io_h5_write_array(g, "domain_hi", 3, m->dom.hi);
     io_h5_write_matrix(g, "x_triangulation", m->n, 3, m->x_tri);
     io_h5_write_matrix(g, "x_previous", m->n, 3, m->x_prev);
     io_h5_write_matrix(g, "force", m->n, 3, m->f);
@@ -50,7 +53,7 @@ static int read_exact(pn_model_t *m, hid_t g, const char *name, long n, double *
     return 0;
 }
 
-int pn_model_state_read(pn_model_t *m, hid_t g, int n, const double *r, int network)
+int pn_model_state_read(pn_model_t *m, hid_t g, int n, const double *r)
 {
     long built = 0, nsnap = 0;
     if (io_h5_get_attr_long(g, "built", &built) || io_h5_get_attr_long(g, "snapshots", &nsnap))
@@ -65,7 +68,7 @@ int pn_model_state_read(pn_model_t *m, hid_t g, int n, const double *r, int netw
         free(c);
         if (rc) return -1;
     }
-    if (!built || !network) return 0;
+    if (!built) return 0;
     long ns = 0, npore = 0, retri = 0, steps = 0, vcur = 0;
     double eps = 0;
     if (io_h5_get_attr_long(g, "spheres", &ns) || io_h5_get_attr_long(g, "pores", &npore) ||
@@ -74,6 +77,11 @@ int pn_model_state_read(pn_model_t *m, hid_t g, int n, const double *r, int netw
         return pn_fail(m->err, sizeof m->err, "the checkpoint's /porenet group lacks an attribute of the state");
     if (ns != n)
         return pn_fail(m->err, sizeof m->err, "the checkpoint's network has %ld spheres, the scene %d", ns, n);
+    /* the network's box (a part may have moved a face, e.g. the oedometer's drained top) and the image
+     * layer the last triangulation started from */
+    if (read_exact(m, g, "domain_lo", 3, m->dom.lo) || read_exact(m, g, "domain_hi", 3, m->dom.hi) ||
+        io_h5_get_attr_double(g, "margin_used", &m->margin_used))
+        return pn_fail(m->err, sizeof m->err, "the checkpoint's /porenet group lacks the network's box");
     double *xt = malloc(3 * (size_t)n * sizeof *xt);
     if (read_exact(m, g, "x_triangulation", 3L * n, xt) || pn_model_rebuild(m, n, xt, r)) {
         free(xt);
@@ -88,6 +96,7 @@ int pn_model_state_read(pn_model_t *m, hid_t g, int n, const double *r, int netw
         read_exact(m, g, "pressure", npore, m->p) || (vcur && read_exact(m, g, "volume", npore, m->vol)))
         return -1;
     pn_solver_set_solution(m->sol, m->p, m->net.npore);
+    m->margin_warned = 3; /* warned by the run that wrote it */
     m->vol_current = (int)vcur;
     m->eps_acc = eps;
     m->n_retri = retri;

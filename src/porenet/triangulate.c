@@ -9,7 +9,9 @@
  * Images: every sphere closer than `margin` to a face is copied across it —
  * shifted by the period on a periodic axis, mirrored on a wall axis (edges
  * and corners get the combined copies) — so that the pores of the box are
- * complete and the wall planes are power bisectors (porenet.h).
+ * complete and the wall planes are power bisectors (porenet.h).  The margin
+ * is checked against what the tetrahedra of the box need (needed_margin: no
+ * image left out can be in conflict with them) and widened until it holds.
  *
  * Degeneracies (co-spherical sets: lattices, and every mirror-symmetric set
  * at a wall): qhull merges the coplanar lifted facets and option Qt splits
@@ -112,14 +114,74 @@ int pn_fail(char *err, size_t nerr, const char *fmt, ...)
     return -1;
 }
 
+/* The triangulation with the images within `margin` of the faces. */
+static int triangulate_once(const pn_domain_t *dom, int n, const double *x, const double *r, double margin, double rmax,
+                            pn_tri_t *t, char *err, size_t nerr);
+
+/* The margin the tetrahedra of the box need: a point left out of the image
+ * layer (some coordinate beyond lo − m or hi + m) lies at least δ_a from the
+ * power centre P of a tetrahedron along that axis, so its power distance is
+ * at least δ_a² − r_max²; if that exceeds the tetrahedron's power radius² w,
+ * no such point can be in conflict with it (the empty-orthosphere property of
+ * a regular triangulation), and the tetrahedron is the one of the complete,
+ * unbounded image set.  Checked for the tetrahedra whose power centre lies in
+ * the box widened by the largest power radius of those inside (the pores of
+ * the box and their neighbours, whose shared facets are the throats).
+ * Returns the smallest margin meeting the condition for all of them. */
+static double needed_margin(const pn_domain_t *dom, const pn_tri_t *t, double rmax)
+{
+    double *w = malloc(((size_t)t->ntet + 1) * sizeof *w), hin = 0;
+    for (int k = 0; k < t->ntet; k++) {
+        const double *P = t->P + 3 * k, *c = t->x + 3 * (size_t)t->tet[4 * k];
+        const double rr = t->r[t->tet[4 * k]];
+        w[k] = (P[0] - c[0]) * (P[0] - c[0]) + (P[1] - c[1]) * (P[1] - c[1]) + (P[2] - c[2]) * (P[2] - c[2]) - rr * rr;
+        int in = 1;
+        for (int a = 0; a < 3; a++) in &= P[a] >= dom->lo[a] && P[a] <= dom->hi[a];
+        if (in && w[k] > 0) hin = fmax(hin, sqrt(w[k]));
+    }
+    double need = 0;
+    for (int k = 0; k < t->ntet; k++) {
+        const double *P = t->P + 3 * k;
+        int near = 1;
+        for (int a = 0; a < 3; a++) near &= P[a] >= dom->lo[a] - hin && P[a] <= dom->hi[a] + hin;
+        if (!near) continue;
+        /* δ_a = m + (distance from P to the nearer face, negative outside) ≥ √(w + r_max²) */
+        const double reach = sqrt(fmax(w[k], 0.0) + rmax * rmax);
+        for (int a = 0; a < 3; a++) need = fmax(need, reach - fmin(P[a] - dom->lo[a], dom->hi[a] - P[a]));
+    }
+    free(w);
+    return need;
+}
+
 int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double *r, double margin, pn_tri_t *t,
                    char *err, size_t nerr)
 {
     memset(t, 0, sizeof *t);
     if (n < 1) return pn_fail(err, nerr, "no spheres");
     double rmax = 0;
+    for (int i = 0; i < n; i++) rmax = fmax(rmax, r[i]);
+    /* auto: start from 2.5 r_max (a dense packing's pores at a face need about 2 r_max).  A margin too
+     * narrow for the packing is widened to what the tetrahedra need (needed_margin), up to 6 r_max or
+     * the margin asked, whichever is wider, and below the box length; the pores that would need more
+     * (those of a sphere-free layer at a face: a fluid layer above a bed) are left as they are, and
+     * t->margin_needed > t->margin tells the caller */
+    double m = margin > 0 ? margin : 2.5 * rmax, cap = fmax(m, 6.0 * rmax);
+    for (int a = 0; a < 3; a++) cap = fmin(cap, 0.999 * (dom->hi[a] - dom->lo[a]));
+    for (int iter = 0;; iter++) {
+        if (triangulate_once(dom, n, x, r, m, rmax, t, err, nerr)) return -1;
+        const double need = needed_margin(dom, t, rmax);
+        t->margin_needed = need;
+        if (need <= m || m >= cap || iter == 8) return 0;
+        pn_tri_free(t);
+        m = fmin(cap, fmax(1.05 * need, 1.25 * m));
+    }
+}
+
+static int triangulate_once(const pn_domain_t *dom, int n, const double *x, const double *r, double margin, double rmax,
+                            pn_tri_t *t, char *err, size_t nerr)
+{
+    memset(t, 0, sizeof *t);
     for (int i = 0; i < n; i++) {
-        rmax = fmax(rmax, r[i]);
         for (int a = 0; a < 3; a++) {
             double v = x[3 * i + a];
             if (!(v >= dom->lo[a] && v <= dom->hi[a]))
@@ -132,11 +194,11 @@ int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double 
                             i, 'x' + a);
         }
     }
-    if (margin <= 0) margin = 6.0 * rmax;
+    (void)rmax;
     t->margin = margin;
     for (int a = 0; a < 3; a++)
         if (margin >= dom->hi[a] - dom->lo[a])
-            return pn_fail(err, nerr, "box length along %c (%g) is not larger than the image margin %g (3 diameters)",
+            return pn_fail(err, nerr, "box length along %c (%g) is not larger than the image margin %g",
                         'x' + a, dom->hi[a] - dom->lo[a], margin);
 
     /* ---- extended point set ---- */
