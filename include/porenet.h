@@ -10,8 +10,8 @@
  *
  * Three stages, each behind a small interface:
  *   pn_triangulate   regular triangulation of the spheres and their images
- *                    (periodic copies, mirror copies across walls) — qhull's
- *                    4-D lift (triangulate.c)
+ *                    (periodic copies, mirror copies across walls) — CGAL's
+ *                    Regular_triangulation_3 or qhull's 4-D lift (triangulate.c)
  *   pn_network_build pores (tetrahedra with coincident power centres merged),
  *                    throats, geometry, conductances, force coefficients
  *                    (network.c)
@@ -76,12 +76,17 @@ typedef struct {
 
 /* Regular triangulation of n spheres (x: 3n, r: n) in the domain.  Returns 0,
  * or -1 with a reason in err (a centre inside another sphere or outside the
- * box, qhull failure).  The image layer is `margin` wide (<= 0: 2.5 maximum
+ * box, qhull failure).  The image layer is `margin` wide (<= 0: 3 maximum
  * radii), widened when the tetrahedra of the box need more, up to 6 maximum
  * radii or `margin` (t->margin: the width used; t->margin_needed <= t->margin:
  * every pore of the box is exact). */
 int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double *r, double margin, pn_tri_t *t,
                    char *err, size_t nerr);
+/* The triangulation engine: CGAL's Regular_triangulation_3 (exact predicates;
+ * the default, pn_triangulate) or qhull's 4-D lift (option Qt). */
+typedef enum { PN_TRI_CGAL = 0, PN_TRI_QHULL } pn_tri_kind_t;
+int pn_triangulate_with(const pn_domain_t *dom, int n, const double *x, const double *r, double margin,
+                        pn_tri_kind_t kind, pn_tri_t *t, char *err, size_t nerr);
 void pn_tri_free(pn_tri_t *t);
 /* Position of extended point `p` for sphere positions x (images follow their sphere). */
 void pn_tri_point(const pn_domain_t *dom, const pn_tri_t *t, const double *x, int p, double out[3]);
@@ -158,6 +163,12 @@ typedef struct pn_solver pn_solver_t;
  * defined up to a constant).  Returns NULL with err on failure. */
 pn_solver_t *pn_solver_create(const pn_domain_t *dom, const pn_net_t *net, pn_solver_kind_t kind, double pcg_tol,
                               char *err, size_t nerr);
+/* The same with a choice of the fill-reducing ordering of CHOLMOD: METIS
+ * (pn_solver_create), or geometric nested dissection of the pores' positions
+ * (ordering.c: cheaper to compute, more fill; for a system solved once). */
+typedef enum { PN_ORDER_METIS = 0, PN_ORDER_GEOMETRIC } pn_ordering_t;
+pn_solver_t *pn_solver_create_ordered(const pn_domain_t *dom, const pn_net_t *net, pn_solver_kind_t kind,
+                                      pn_ordering_t ordering, double pcg_tol, char *err, size_t nerr);
 void pn_solver_free(pn_solver_t *s);
 /* Pressures (p: npore) for pore volume rates dvdt (npore, NULL: zero, rigid
  * skeleton) and the domain's boundary values.  Returns 0, or -1 if PCG did not
@@ -198,6 +209,8 @@ typedef struct {
     pn_domain_t dom;
     pn_params_t prm;
     pn_solver_kind_t kind;
+    pn_tri_kind_t tri_kind; /* porenet.triangulation */
+    pn_ordering_t ordering; /* porenet.ordering (auto resolved: geometric for a fixed packing) */
     double pcg_tol;
     double eps_retri;   /* re-triangulate when Σ_steps max_i |ΔV_i/V_i| exceeds this (thesis 5.13–5.14); 0: every step */
     double margin;      /* image layer (0: auto) */

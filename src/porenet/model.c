@@ -45,7 +45,8 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
     pn_tri_free(&m->tri);
     double t0 = cputime();
     /* the width the last triangulation needed: the next one starts there (auto margin) */
-    if (pn_triangulate(&m->dom, n, x, r, m->margin > 0 ? m->margin : m->margin_used, &m->tri, m->err, sizeof m->err))
+    if (pn_triangulate_with(&m->dom, n, x, r, m->margin > 0 ? m->margin : m->margin_used, m->tri_kind, &m->tri, m->err,
+                            sizeof m->err))
         return -1;
     m->margin_used = m->tri.margin;
     if (m->tri.margin_needed > m->tri.margin && !(m->margin_warned & 2)) {
@@ -62,7 +63,7 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
     double t1 = cputime();
     if (pn_network_build(&m->dom, &m->prm, &m->tri, x, r, n, &m->net, m->err, sizeof m->err)) return -1;
     double t2 = cputime();
-    m->sol = pn_solver_create(&m->dom, &m->net, m->kind, m->pcg_tol, m->err, sizeof m->err);
+    m->sol = pn_solver_create_ordered(&m->dom, &m->net, m->kind, m->ordering, m->pcg_tol, m->err, sizeof m->err);
     if (!m->sol) return -1;
     m->t_tri = t1 - t0;
     m->t_net = t2 - t1;
