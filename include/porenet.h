@@ -76,7 +76,7 @@ typedef struct {
 
 /* Regular triangulation of n spheres (x: 3n, r: n) in the domain.  Returns 0,
  * or -1 with a reason in err (a centre inside another sphere or outside the
- * box, qhull failure).  The image layer is `margin` wide (<= 0: 3 maximum
+ * box, qhull failure).  The image layer is `margin` wide (<= 0: 2.75 maximum
  * radii), widened when the tetrahedra of the box need more, up to 6 maximum
  * radii or `margin` (t->margin: the width used; t->margin_needed <= t->margin:
  * every pore of the box is exact). */

@@ -45,7 +45,7 @@ static const cfg_key_t porenet_keys[] = {
      "network snapshots (porenet_NNNNN.h5 + porenet.xmf, at the run's snapshot times): auto = with DEM particles "
      "only (a fixed packing is solved once: its results are in summary.json), on, off"},
     {"porenet", "margin", CFG_DOUBLE, "0", 0, BIG, NULL,
-     "width of the layer of sphere images across the faces (m); 0: 3 largest radii; widened (with a warning "
+     "width of the layer of sphere images across the faces (m); 0: 2.75 largest radii; widened (with a warning "
      "when given) to what the pores of the box need: a narrower layer would lose or change pores"},
     {"porenet", "packing", CFG_STRING, NULL, 1, 0, NULL,
      "fixed packing when the scene has no DEM particles ([particles]): text (x y z r per line, # comments) "

@@ -190,12 +190,12 @@ int pn_triangulate_with(const pn_domain_t *dom, int n, const double *x, const do
     if (n < 1) return pn_fail(err, nerr, "no spheres");
     double rmax = 0;
     for (int i = 0; i < n; i++) rmax = fmax(rmax, r[i]);
-    /* auto: start from 3 r_max (a dense packing's pores at a face need 2.5–3 r_max).  A margin too
+    /* auto: start from 2.75 r_max (a dense packing's pores at a face need about 2.6 r_max).  A margin too
      * narrow for the packing is widened to what the tetrahedra need (needed_margin), up to 6 r_max or
      * the margin asked, whichever is wider, and below the box length; the pores that would need more
      * (those of a sphere-free layer at a face: a fluid layer above a bed) are left as they are, and
      * t->margin_needed > t->margin tells the caller */
-    double m = margin > 0 ? margin : 3.0 * rmax, cap = fmax(m, 6.0 * rmax);
+    double m = margin > 0 ? margin : 2.75 * rmax, cap = fmax(m, 6.0 * rmax);
     for (int a = 0; a < 3; a++) cap = fmin(cap, 0.999 * (dom->hi[a] - dom->lo[a]));
     for (int iter = 0;; iter++) {
         if (triangulate_once(dom, n, x, r, m, rmax, kind, t, err, nerr)) return -1;
