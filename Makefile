@@ -6,6 +6,7 @@
 #   make restitution  restitution sweeps of issue 5 (wall and binary; 1.3 min on 2 cores, measured in session 8);
 #                   RESTITUTION_SET='section.key=value ...' overrides keys in every run,
 #                   RESTITUTION_OUT=dir the output directory (default build/restitution)
+#   make bounce     the bouncing sphere against experiments, lubrication cut-off, oblique bounces (FULL=1: finer)
 #   make bench      benchmarks, results appended to docs/performance.md
 #   make deps       install missing Debian packages (apt-get)
 #   SANITIZE=1      build with AddressSanitizer + UBSan into build-san/
@@ -40,7 +41,7 @@ BIN     := $(BUILD)/ibmdem
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 BENCHES := $(patsubst bench/%.c,$(BUILD)/bench/%,$(wildcard bench/bench_*.c))
 
-.PHONY: all test demo validate bench deps clean restitution
+.PHONY: all test demo validate bench deps clean restitution bounce
 all: $(BIN) $(TESTS) $(BENCHES)
 
 $(BUILD)/obj/%.o: src/%.c
@@ -102,6 +103,12 @@ RESTITUTION_OUT ?= $(BUILD)/restitution
 restitution: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bash scripts/restitution.sh $(RESTITUTION_OUT) full $(RESTITUTION_SET)
+
+# the bouncing sphere against the experiments of Gondret et al. (2002), the lubrication cut-off and the
+# oblique bounces (part of make validate); FULL=1 adds D/dx = 40 (and 30 at St 152): about 3 hours
+bounce: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) OUT=$(BUILD)/bounce FULL=$(FULL) bash scripts/validate_bounce.sh
 
 clean:
 	rm -rf build build-san

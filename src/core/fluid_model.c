@@ -3,6 +3,8 @@
 
 #include <string.h>
 
+#include "fluid.h"
+
 static const cfg_key_t model_keys[] = {
     {"coupling", "fluid", CFG_ENUM, "auto", 1, 0, "auto|resolved|porenet|drag|lubrication|none|off",
      "the fluid model: resolved ([fluid]: particles are immersed spheres, DEM sub-cycled in each fluid step), "
@@ -34,8 +36,8 @@ fluid_model_t fluid_model_of(cfg_t *cfg)
         return FLUID_MODEL_PORENET;
     case KEY_DRAG: return FLUID_MODEL_DRAG;
     case KEY_LUBRICATION:
-        if (cfg_enum(cfg, "lubrication", "model") != 1)
-            cfg_fail(cfg, "coupling", "fluid", "lubrication needs [lubrication] model = brenner");
+        if (cfg_enum(cfg, "lubrication", "model") == 0)
+            cfg_fail(cfg, "coupling", "fluid", "lubrication needs a [lubrication] model (brenner or correction)");
         return FLUID_MODEL_LUBRICATION;
     case KEY_NONE: return FLUID_MODEL_NONE;
     case KEY_OFF: return FLUID_MODEL_LUBRICATION;
@@ -63,6 +65,6 @@ double fluid_model_viscosity(cfg_t *cfg)
     const fluid_model_t m = fluid_model_of(cfg);
     if (m == FLUID_MODEL_DRAG && cfg_double(cfg, "drag", "viscosity") > 0) return cfg_double(cfg, "drag", "viscosity");
     if (m == FLUID_MODEL_PORENET) return cfg_double(cfg, "porenet", "viscosity");
-    if (cfg_has_section(cfg, "fluid")) return cfg_double(cfg, "fluid", "rho") * cfg_double(cfg, "fluid", "nu");
+    if (cfg_has_section(cfg, "fluid")) return cfg_double(cfg, "fluid", "rho") * fluid_nu_from_config(cfg);
     return -1;
 }

@@ -37,6 +37,7 @@
 #include <string.h>
 
 #include "dem_private.h"
+#include "fluid.h"
 #include "fluid_model.h"
 #include "util.h"
 
@@ -76,7 +77,7 @@ void dem_drag_config(dem_t *d, cfg_t *cfg)
     const int fluid = cfg_has_section(cfg, "fluid");
     if (D->mu < 0) {
         if (!fluid) cfg_fail(cfg, "drag", "viscosity", "needed: the case has no [fluid] section to take rho nu from");
-        D->mu = cfg_double(cfg, "fluid", "rho") * cfg_double(cfg, "fluid", "nu");
+        D->mu = cfg_double(cfg, "fluid", "rho") * fluid_nu_from_config(cfg);
     }
     if (!(D->mu > 0)) cfg_fail(cfg, "drag", "viscosity", "must be positive");
     if (D->rho_f < 0) {
