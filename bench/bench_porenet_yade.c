@@ -9,6 +9,8 @@
  *  1. permeability along z: p = 1 on z = 0, p = 0 on z = L, no flux through
  *     the four lateral walls (slip: symmetry planes, YADE's default
  *     slipBoundary), μ = 1, κ = μ Q L/(ΔP S) (pn_model_permeability);
+ *     computed REPS times from scratch (default 3 up to N = 5000, 1 beyond),
+ *     the smallest CPU time of each part kept;
  *  2. the coupled step: the DEM (linear spring–dashpot, gravity −z, walls)
  *     with the pore network coupled every step (pn_model_couple_dem, the
  *     driver's sequence), z = L at p = 0, no flux elsewhere, μ = 1.  The
@@ -114,6 +116,8 @@ int main(int argc, char **argv)
      * same kappa to round-off */
     static const char *const model[3] = {"mirror", "yade", "mirror"};
     static const char *const engine[3] = {"", "", "triangulation = qhull\nordering = metis\nmargin = %.17g\n"};
+    /* REPS: computations of each permeability (default 3 up to 5000 spheres, 1 beyond) */
+    const int reps = getenv("REPS") && atoi(getenv("REPS")) > 0 ? atoi(getenv("REPS")) : n <= 5000 ? 3 : 1;
     double kappa0 = 0, rmax = 0;
     for (int i = 0; i < n; i++) rmax = fmax(rmax, r[i]);
     for (int wm = 0; wm < 3; wm++) {
@@ -125,10 +129,17 @@ int main(int argc, char **argv)
                  model[wm], eng);
         cfg_t *cfg = make_cfg(L, flow, argc - 4, argv + 4);
         pn_model_t m;
-        pn_model_from_config(cfg, &m);
-        const double c0 = cputime();
-        if (pn_model_step(&m, n, x, r, 0.0)) die("porenet: %s", m.err);
-        const double c_total = cputime() - c0;
+        /* the smallest CPU time of each part over `reps` computations from scratch in this process
+         * (the first pays the process's first touches of its heap; YADE's half does the same) */
+        double best[5] = {INFINITY, INFINITY, INFINITY, INFINITY, INFINITY};
+        for (int rep = 0; rep < reps; rep++) {
+            if (rep) pn_model_free(&m);
+            pn_model_from_config(cfg, &m);
+            const double c0 = cputime();
+            if (pn_model_step(&m, n, x, r, 0.0)) die("porenet: %s", m.err);
+            const double part[5] = {m.t_tri, m.t_net, m.t_factor, m.t_solve, cputime() - c0};
+            for (int k = 0; k < 5; k++) best[k] = fmin(best[k], part[k]);
+        }
         const double kappa = pn_model_permeability(&m, 2);
         if (wm == 0) kappa0 = kappa;
         double q[6];
@@ -138,10 +149,10 @@ int main(int argc, char **argv)
         if (mpi_rank() == 0)
             printf("RESULT ibmdem_perm N= %d wall_throats= %s engine= %s L= %.10g kappa= %.10e kappa/d2= %.10e Q_in= %.10e "
                    "Q_out= %.10e pores= %d throats= %d tri_s= %.4g net_s= %.4g factor_s= %.4g solve_s= %.4g total_s= %.4g "
-                   "points= %d margin_rmax= %.3g wall_overlap= %.2e kappa_rel_to_first= %.2e\n",
+                   "points= %d margin_rmax= %.3g wall_overlap= %.2e kappa_rel_to_first= %.2e reps= %d\n",
                    n, model[wm], wm == 2 ? "qhull+metis+6rmax" : "default", L, kappa, kappa / 4.0, q[4], -q[5], m.net.npore,
-                   m.net.nthroat, m.t_tri, m.t_net, m.t_factor, m.t_solve, c_total, m.tri.npts, m.tri.margin / rmax,
-                   fmax(worst, 0), kappa / kappa0 - 1);
+                   m.net.nthroat, best[0], best[1], best[2], best[3], best[4], m.tri.npts, m.tri.margin / rmax,
+                   fmax(worst, 0), kappa / kappa0 - 1, reps);
         fflush(stdout);
         pn_model_free(&m);
         cfg_free(cfg);

@@ -5,7 +5,7 @@
 # the load average, since a busy machine skews wall times).
 #
 #   ONLY=regex   run only the sections whose name matches (fluid, poisson,
-#                multigrid, porenet, dem, ibm)
+#                multigrid, porenet, dry, dem, ibm)
 #   N=64         grid size of the fluid/Poisson benches (default 128)
 #   FFTW_WISDOM  wisdom file of the measuring planner (default $BUILD/bench_results/fftw.wisdom)
 #   Builds nothing (`make bench` builds first).
@@ -54,6 +54,10 @@ if want porenet && [ -x "$BUILD/bench/bench_porenet" ]; then
     run porenet_yade bash bench/porenet_vs_yade.sh
     [ -f "$BUILD/bench_porenet_yade/porenet_yade.md" ] &&
         sed 's/^/[porenet_yade] /' "$BUILD/bench_porenet_yade/porenet_yade.md" >>"$RES"
+fi
+if want dry; then
+    # the dry switch (coupling.fluid = off) of every shipped coupled case against the DEM alone
+    run dry_switch bash bench/dry_switch.sh
 fi
 if want ibm && [ -x "$BUILD/bench/bench_ibm" ]; then
     for np in 1 2; do run ibm_np$np $MPIRUN -np $np "$BUILD/bench/bench_ibm"; done

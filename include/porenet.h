@@ -143,7 +143,8 @@ typedef struct {
     int n_negative_area;             /* facets whose fluid area was ≤ 0 (overlaps) */
 } pn_net_t;
 
-/* Build the network of a triangulation for sphere positions x / radii r. */
+/* Build the network of a triangulation for sphere positions x / radii r.  0; -2 when a pore of
+ * the box reaches the rim of the point cloud (the image layer is too narrow), -1 otherwise. */
 int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tri_t *t, const double *x,
                      const double *r, int n, pn_net_t *net, char *err, size_t nerr);
 void pn_network_free(pn_net_t *net);
@@ -232,6 +233,11 @@ typedef struct {
     int dem_steps;      /* DEM steps per coupled step (multi-rate), within ζ Δt_{M−V} */
     double eps_acc;     /* accumulated pore strain since the last triangulation */
     long n_retri, n_steps;
+    /* re-meshing statistics: over the rebuilds of a run that replaced a triangulation, the sum and
+     * the smallest of the fraction of the new triangulation's tetrahedra of the box (power centre
+     * inside) that the one it replaced had (same spheres, same images) */
+    long kept_count;
+    double kept_sum, kept_min;
     /* CPU times of the process (cputime(): the machine may be shared): last triangulation / network /
      * factorisation, cumulated rebuilds (all three), volume rates, solves (right-hand side and
      * back-substitution) and forces */

@@ -12,8 +12,9 @@
 #     regressions, not Terzaghi's accuracy;
 #  2. multi-rate (docs/theory.md §8): two DEM steps per coupled step give p_mid, p_base, U and U_marker
 #     at the four T_v within 1e-3 of the run solving every DEM step (measured 6.3e-4);
-#  3. restart: the run stopped at step 3000 and restarted gives the same summary.json values (the
-#     CPU times aside), pressure_profile.csv and series.csv rows, bit for bit;
+#  3. restart: the run stopped at step 3000 and restarted gives the same summary.json values of the
+#     oedometer and the network (the CPU times aside: the re-meshing statistics included),
+#     pressure_profile.csv and series.csv rows, bit for bit;
 #  4. the figure and the table of postproc/plot_consolidation.py.
 # Prints TAP lines; about 30 s of CPU.
 . "$(dirname "$0")/tap.sh"
@@ -24,12 +25,14 @@ $BIN run $INI $Q --out $T/default >$T/default.log 2>&1
 report $? "coarse.ini runs to T_v = 1"
 $PY - $T/default/summary.json <<'PY'
 import json, sys
-o = json.load(open(sys.argv[1]))["oedometer"]
+s = json.load(open(sys.argv[1]))
+o, pn = s["oedometer"], s["porenet"]
 COARSE_TOL, MARKER_TOL, RAW_TOL = 0.09, 0.055, 0.10
 print(f"# {o['coupled_steps']} coupled steps, E_oed {o['E_oed']:.5g} Pa, kappa/d^2 {o['kappa_over_d2']:.4g}, "
       f"C_v {o['C_v']:.4g} m^2/s; peak p_base {o['p_base_max']:.3f}; deviations {o['deviation']:.4f} (p, U_corr), "
       f"{o['deviation_marker']:.4f} (marker), {o['deviation_raw_U']:.4f} (raw U); d_s {o['taylor_zero']:.4f}; "
-      f"coupled/dry step {o['coupled_over_dry']:.1f}")
+      f"coupled/dry step {o['coupled_over_dry']:.1f}; {pn['triangulations']} triangulations in {pn['coupled_steps']} "
+      f"coupled steps, a new one keeps {pn['remesh_kept_mean']:.3f} of the tetrahedra (at least {pn['remesh_kept_min']:.3f})")
 ok = (o["Tv_points"] == 4 and o["p_base_max"] > 0.95 and o["deviation"] < COARSE_TOL and o["deviation_marker"] < MARKER_TOL
       and o["deviation_raw_U"] < RAW_TOL and 0 < o["taylor_zero"] < 0.3)
 sys.exit(0 if ok else 1)
@@ -58,7 +61,7 @@ def flat(d, pre=""):
             yield from flat(v, pre + k + ".")
         elif not any(w in k for w in ("cpu", "over_dry", "time", "wall", "per_second")):
             yield pre + k, v
-fa, fb = dict(flat(a["oedometer"])), dict(flat(b["oedometer"]))
+fa, fb = (dict(flat({"oedometer": s["oedometer"], "porenet": s["porenet"]})) for s in (a, b))
 diff = [k for k in fa if fa[k] != fb.get(k)]
 prof = open(sys.argv[1] + "/pressure_profile.csv").read() == open(sys.argv[2] + "/pressure_profile.csv").read()
 rows = lambda p: [",".join(l.split(",")[:-1]) for l in open(p + "/series.csv")]

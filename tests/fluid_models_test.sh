@@ -1,7 +1,7 @@
 #!/bin/bash
 # fluid_models_test.sh — the fluid model named by one key, [coupling] fluid (fluid_model.h):
-#  1. the dry switch: every shipped case with particles and a fluid (resolved or pore network)
-#     runs with --set coupling.fluid=off, as the DEM alone (no fluid, immersed-boundary or
+#  1. the dry switch: every shipped case with particles and a fluid (resolved or pore network,
+#     found in cases/) runs with --set coupling.fluid=off, as the DEM alone (no fluid, immersed-boundary or
 #     pore-network part in summary.json), and its log names the model and notes the keys of
 #     the other sections as not used;
 #  2. a case without particles has nothing to simulate dry: exit 2, and the message names the
@@ -18,9 +18,15 @@
 T=$(mktemp -d /tmp/ibmdem_fluid_models.XXXXXX)
 Q="--set output.progress=off"
 
-# 1. the dry switch
-for c in bouncing_sphere/bounce_axi bouncing_sphere/bounce_3d binary_collision/binary_axi \
-    porenet_deposition/coarse consolidation/coarse consolidation/oedometer; do
+# 1. the dry switch, on every shipped case with particles ([particles] with a source) and a fluid
+# ([fluid] or [porenet])
+coupled=$(for f in cases/*/*.ini; do
+    awk '/^\[/ { sec = $1 } sec == "[particles]" && $1 == "source" && $3 != "none" { p = 1 }
+         $1 == "[fluid]" || $1 == "[porenet]" { fl = 1 } END { exit !(p && fl) }' "$f" && echo "${f#cases/}"
+done | sed 's/\.ini$//')
+[ "$(echo $coupled | wc -w)" -ge 9 ]
+report $? "the shipped coupled cases: $(echo $coupled | wc -w) ($(echo $coupled | tr '\n' ' '))"
+for c in $coupled; do
     nm=$(echo $c | tr / _)
     $BIN run cases/$c.ini $Q --set coupling.fluid=off --set time.max_steps=20 --out $T/$nm >$T/$nm.log 2>&1
     rc=$?

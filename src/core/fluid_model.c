@@ -9,7 +9,7 @@ static const cfg_key_t model_keys[] = {
     {"coupling", "fluid", CFG_ENUM, "auto", 1, 0, "auto|resolved|porenet|drag|lubrication|none|off",
      "the fluid model: resolved ([fluid]: particles are immersed spheres, DEM sub-cycled in each fluid step), "
      "porenet (the pore network of [porenet]), drag (DEM + drag closure + buoyancy of [drag], with [lubrication]), "
-     "lubrication (DEM + Brenner lubrication), none (the DEM alone), off (dry: the DEM with [lubrication] as set); "
+     "lubrication (DEM + the lubrication of [lubrication]), none (the DEM alone), off (dry: the DEM with [lubrication] as set); "
      "auto: the model whose section the case has (none of them: off); sections of other models are not used"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
 };

@@ -257,6 +257,13 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
     io_summary_long(y, KEY("%s.throats", prefix), m->net.nthroat);
     io_summary_long(y, KEY("%s.triangulations", prefix), m->n_retri);
     io_summary_long(y, KEY("%s.coupled_steps", prefix), m->n_steps);
+    if (m->kept_count > 0) {
+        /* re-meshing: the mean and smallest fraction of a new triangulation's tetrahedra of the box that
+         * the one it replaced had */
+        io_summary_double(y, KEY("%s.remesh_kept_mean", prefix), m->kept_sum / m->kept_count);
+        io_summary_double(y, KEY("%s.remesh_kept_min", prefix), m->kept_min);
+        io_summary_double(y, KEY("%s.time_rebuilds", prefix), m->t_rebuild);
+    }
     const double d = mean_diameter(pp);
     io_summary_double(y, KEY("%s.mean_diameter", prefix), d);
     for (int a = 0; a < 3; a++)

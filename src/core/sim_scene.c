@@ -105,13 +105,15 @@ static void count_unused(const char *section, const char *key, int line, void *c
 
 void sim_note_unused(const sim_t *s)
 {
-    static const char *what[] = {"none (the DEM alone)", "lubrication (the DEM with Brenner lubrication)",
+    static const char *what[] = {"none (the DEM alone)", "lubrication (the DEM with lubrication, [lubrication] model = ",
                                  "drag (the DEM with a drag closure, buoyancy and [lubrication])",
                                  "porenet (the pore network)", "resolved (the resolved fluid)"};
     int m = s->fluid_model;
     /* (the lubrication model was read by the DEM in every model but none) */
     if (m == FLUID_MODEL_LUBRICATION && cfg_enum(s->cfg, "lubrication", "model") == 0) m = FLUID_MODEL_NONE;
-    msg("fluid model: %s; coupling.fluid = %s\n", what[m], cfg_string(s->cfg, "coupling", "fluid"));
+    const int lub = m == FLUID_MODEL_LUBRICATION;
+    msg("fluid model: %s%s%s; coupling.fluid = %s\n", what[m], lub ? cfg_string(s->cfg, "lubrication", "model") : "",
+        lub ? ")" : "", cfg_string(s->cfg, "coupling", "fluid"));
     int n = 0;
     cfg_foreach_unused(s->cfg, count_unused, &n);
     if (n == 0) return;

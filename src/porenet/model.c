@@ -28,6 +28,7 @@ void pn_model_free(pn_model_t *m)
     free(m->rid);
     free(m->snap_time);
     free(m->snap_counts);
+
     m->snap_time = NULL;
     m->snap_counts = NULL;
     m->nsnap = 0;
@@ -37,17 +38,100 @@ void pn_model_free(pn_model_t *m)
     m->built = 0;
 }
 
+static int cmp_key_1(const void *a, const void *b)
+{
+    const long long x = *(const long long *)a, y = *(const long long *)b;
+    return x < y ? -1 : x > y;
+}
+
+static int cmp_key(const void *a, const void *b)
+{
+    const long long *x = a, *y = b;
+    for (int k = 0; k < 4; k++)
+        if (x[k] != y[k]) return x[k] < y[k] ? -1 : 1;
+    return 0;
+}
+
+/* The tetrahedra of the box (power centre inside) of the current triangulation as sorted
+ * quadruples of (sphere, image) codes, the array sorted (the re-meshing statistics). */
+static int tet_keys(const pn_model_t *m, long long (**out)[4])
+{
+    const pn_tri_t *t = &m->tri;
+    long long(*key)[4] = malloc(((size_t)t->ntet + 1) * sizeof *key);
+    int nk = 0;
+    for (int k = 0; k < t->ntet; k++) {
+        const double *P = t->P + 3 * k;
+        int in = 1;
+        for (int a = 0; a < 3; a++) in &= P[a] >= m->dom.lo[a] && P[a] <= m->dom.hi[a];
+        if (!in) continue;
+        for (int v = 0; v < 4; v++) {
+            const int q = t->tet[4 * k + v];
+            const signed char *g = t->img + 3 * (size_t)q;
+            key[nk][v] = 27LL * t->id[q] + 9 * (g[0] + 1) + 3 * (g[1] + 1) + (g[2] + 1);
+        }
+        qsort(key[nk], 4, sizeof key[nk][0], cmp_key_1);
+        nk++;
+    }
+    qsort(key, (size_t)nk, sizeof *key, cmp_key);
+    *out = key;
+    return nk;
+}
+
+/* The fraction of the new triangulation's tetrahedra of the box that the replaced one had (old:
+ * its tet_keys), into the statistics; frees old. */
+static void remesh_stats(pn_model_t *m, long long (*old)[4], int nold)
+{
+    long long(*key)[4] = NULL;
+    const int nk = tet_keys(m, &key);
+    if (nk > 0) {
+        long kept = 0;
+        for (int i = 0, j = 0; i < nk && j < nold;) {
+            const int c = cmp_key(key[i], old[j]);
+            if (c == 0) kept++, i++, j++;
+            else if (c < 0) i++;
+            else j++;
+        }
+        const double f = (double)kept / nk;
+        m->kept_min = m->kept_count ? fmin(m->kept_min, f) : f;
+        m->kept_sum += f;
+        m->kept_count++;
+    }
+    free(key);
+    free(old);
+}
+
 int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
 {
+    /* a coupled run's rebuild replacing a triangulation: what it keeps of it (diagnostic) */
+    long long(*old)[4] = NULL;
+    const int nold = m->built && m->eps_retri > 0 ? tet_keys(m, &old) : 0;
     pn_solver_free(m->sol);
     m->sol = NULL;
     pn_network_free(&m->net);
     pn_tri_free(&m->tri);
-    double t0 = cputime();
-    /* the width the last triangulation needed: the next one starts there (auto margin) */
-    if (pn_triangulate_with(&m->dom, n, x, r, m->margin > 0 ? m->margin : m->margin_used, m->tri_kind, &m->tri, m->err,
-                            sizeof m->err))
-        return -1;
+    double t0 = cputime(), t1 = t0;
+    /* the width the last triangulation needed: the next one starts there (auto margin).  A pore of
+     * the box that still reaches the rim of the cloud (the criterion of the triangulation can miss
+     * the large power spheres of a sphere-free layer at a face) widens the layer by half, up to the
+     * box's length, and the triangulation is made again */
+    double mg = m->margin > 0 ? m->margin : m->margin_used, mcap = INFINITY;
+    for (int a = 0; a < 3; a++) mcap = fmin(mcap, 0.999 * (m->dom.hi[a] - m->dom.lo[a]));
+    for (int attempt = 0;; attempt++) {
+        if (pn_triangulate_with(&m->dom, n, x, r, mg, m->tri_kind, &m->tri, m->err, sizeof m->err)) {
+            free(old);
+            return -1;
+        }
+        t1 = cputime();
+        const int rc = pn_network_build(&m->dom, &m->prm, &m->tri, x, r, n, &m->net, m->err, sizeof m->err);
+        if (rc == 0) break;
+        if (rc != -2 || m->tri.margin >= mcap || attempt == 6) {
+            free(old);
+            return -1;
+        }
+        mg = fmin(mcap, 1.5 * m->tri.margin);
+        pn_network_free(&m->net);
+        pn_tri_free(&m->tri);
+    }
     m->margin_used = m->tri.margin;
     if (m->tri.margin_needed > m->tri.margin && !(m->margin_warned & 2)) {
         warn("porenet: pores at the faces have power spheres reaching beyond the widest image layer used (%g; "
@@ -60,15 +144,17 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
              m->margin, m->tri.margin_needed, m->tri.margin);
         m->margin_warned |= 1;
     }
-    double t1 = cputime();
-    if (pn_network_build(&m->dom, &m->prm, &m->tri, x, r, n, &m->net, m->err, sizeof m->err)) return -1;
     double t2 = cputime();
     m->sol = pn_solver_create_ordered(&m->dom, &m->net, m->kind, m->ordering, m->pcg_tol, m->err, sizeof m->err);
-    if (!m->sol) return -1;
+    if (!m->sol) {
+        free(old);
+        return -1;
+    }
     m->t_tri = t1 - t0;
     m->t_net = t2 - t1;
     m->t_factor = cputime() - t2;
     m->t_rebuild += cputime() - t0;
+    if (old) remesh_stats(m, old, nold);
     int np = m->net.npore;
     m->p = realloc(m->p, (size_t)np * sizeof *m->p);
     m->vol = realloc(m->vol, (size_t)np * sizeof *m->vol);

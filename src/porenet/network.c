@@ -501,9 +501,9 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
                         beyond = lo || hi;
                     }
                     if (beyond) continue;
-                    status = pn_fail(err, nerr,
-                                  "pore %d reaches the rim of the triangulated cloud: image margin (%g) too small",
-                                  pi, t->margin);
+                    pn_fail(err, nerr, "pore %d reaches the rim of the triangulated cloud: image margin (%g) too small",
+                            pi, t->margin);
+                    status = -2;
                     break;
                 }
                 int nb = cl[u];
@@ -595,7 +595,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
     if (status) {
         free(cl), free(cstart), free(clist), free(st), free(cw), free(cP), free(pore_of), free(proot);
         free(tp), free(tfv), free(tdx), free(twt), free(tplane), free(tPi), free(tPj);
-        return -1;
+        return status < 0 ? status : -1;
     }
 
     /* ---- pores: centre, weight, faces, tetrahedra, volumes ---- */

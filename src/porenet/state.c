@@ -35,6 +35,9 @@ int pn_model_state_write(const pn_model_t *m, hid_t g)
     io_h5_attr_long(g, "volumes_current", m->vol_current);
     io_h5_attr_double(g, "strain_accumulated", m->eps_acc);
     io_h5_attr_double(g, "margin_used", m->margin_used);
+    io_h5_attr_long(g, "remesh_count", m->kept_count);
+    io_h5_attr_double(g, "remesh_kept_sum", m->kept_sum);
+    io_h5_attr_double(g, "remesh_kept_min", m->kept_min);
     io_h5_write_array(g, "domain_lo", 3, m->dom.lo);
     io_h5_write_array(g, "domain_hi", 3, m->dom.hi);
     io_h5_write_matrix(g, "x_triangulation", m->n, 3, m->x_tri);
@@ -101,5 +104,8 @@ int pn_model_state_read(pn_model_t *m, hid_t g, int n, const double *r)
     m->eps_acc = eps;
     m->n_retri = retri;
     m->n_steps = steps;
+    if (io_h5_get_attr_long(g, "remesh_count", &m->kept_count) || io_h5_get_attr_double(g, "remesh_kept_sum", &m->kept_sum) ||
+        io_h5_get_attr_double(g, "remesh_kept_min", &m->kept_min))
+        return pn_fail(m->err, sizeof m->err, "the checkpoint's /porenet group lacks the re-meshing statistics");
     return 0;
 }
