@@ -23,7 +23,7 @@ BUILD   ?= build
 OPT     := -O3 -march=native -g
 endif
 CFLAGS  := $(STD) $(OPT) $(WARN) -Iinclude $(HDF5_CFLAGS) $(EXTRA_CFLAGS)
-LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -linih -lgsl -lgslcblas -lqhull_r -lcholmod -lsuitesparseconfig -lm -fopenmp
+LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -lgsl -lgslcblas -lqhull_r -lcholmod -lsuitesparseconfig -lm -fopenmp
 TESTLIBS := -lcmocka
 
 SRC     := $(filter-out src/main.c,$(shell find src -name '*.c' | sort))

@@ -66,6 +66,10 @@ typedef struct sim_part {
     /* Non-zero when the part has what the run was for (e.g. a measured
      * bounce): the run stops as at t_end.  NULL: never. */
     int (*done)(void *ctx);
+    /* Non-zero with a reason when the part cannot go on from the state it is
+     * in though nothing diverged (e.g. a contact it has no law for): the run
+     * stops with its final outputs, the reason and exit status 1.  NULL: never. */
+    int (*halt)(void *ctx, char *why, size_t nwhy);
     void (*destroy)(void *ctx);
 } sim_part_t;
 
@@ -92,7 +96,16 @@ typedef struct {
  * io_snapshot_end of every snapshot. */
 typedef void (*sim_field_writer_t)(void *ctx, io_snapshots_t *snap);
 
-typedef enum { SIM_RUNNING = 0, SIM_T_END, SIM_MAX_STEPS, SIM_WALL_LIMIT, SIM_STEADY, SIM_DIVERGED, SIM_DONE } sim_status_t;
+typedef enum {
+    SIM_RUNNING = 0,
+    SIM_T_END,
+    SIM_MAX_STEPS,
+    SIM_WALL_LIMIT,
+    SIM_STEADY,
+    SIM_DIVERGED,
+    SIM_DONE,
+    SIM_HALTED
+} sim_status_t;
 
 struct sim {
     cfg_t *cfg;
@@ -112,7 +125,7 @@ struct sim {
     double wall0, wall_step; /* start of the run; wall time of the last step */
     long step0;              /* step at the start of this run (restart) */
     sim_status_t status;
-    char why[512];           /* why the run diverged */
+    char why[512];           /* why the run diverged or halted */
     /* outputs */
     io_outdir_t out;
     io_series_t *series;
@@ -137,7 +150,8 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only);
 /* Add a part (called from sim_create). */
 void sim_add_part(sim_t *s, const sim_part_t *part);
 /* Run to the end; returns the exit status: 0 when the run finished (t_end,
- * max_steps, steady state or wall_limit), 3 when it diverged. */
+ * max_steps, steady state or wall_limit), 1 when a part halted it, 3 when it
+ * diverged. */
 int sim_run(sim_t *s);
 void sim_free(sim_t *s);
 

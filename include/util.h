@@ -30,6 +30,10 @@ double cputime(void);
 /* Peak resident set size of this process in bytes (from /proc/self/status). */
 long peak_rss_bytes(void);
 
+/* Bytes of memory of this machine (INFINITY if unknown): input that needs
+ * more is refused before the run. */
+double physical_memory_bytes(void);
+
 int mpi_rank(void);
 int mpi_size(void);
 

@@ -146,13 +146,20 @@ int main(int argc, char **argv)
         }
     }
     if (!path) return usage_error("%s: missing CASE.ini", cmd);
-    char outset[IO_PATH_MAX + 16];
+    if (restart && strlen(restart) >= IO_PATH_MAX) {
+        char lim[32];
+        snprintf(lim, sizeof lim, "%d", IO_PATH_MAX - 1);
+        return usage_error("--restart: a path longer than %s bytes", lim);
+    }
+    char *outset = NULL;
     if (out) {
-        snprintf(outset, sizeof outset, "output.dir=%s", out);
+        outset = malloc(strlen(out) + 16);
+        sprintf(outset, "output.dir=%s", out);
         sets[nset++] = outset; /* last: wins over the file and other --set */
     }
 
     cfg_t *cfg = cfg_load(path, nset, sets);
+    free(outset);
     if (!cfg) {
         /* the messages are printed; every rank parsed the same input */
         MPI_Finalize();

@@ -58,6 +58,8 @@ static void read_params(sim_t *s, cfg_t *cfg)
     p->rollback = cfg_bool(cfg, "time", "rollback");
     /* The case name defaults to the file name without its directory and .ini */
     if (cfg_has(cfg, "output", "name")) {
+        if (strlen(cfg_string(cfg, "output", "name")) >= sizeof p->name)
+            cfg_fail(cfg, "output", "name", "longer than %zu bytes", sizeof p->name - 1);
         snprintf(p->name, sizeof p->name, "%s", cfg_string(cfg, "output", "name"));
     } else {
         const char *base = strrchr(cfg_path(cfg), '/');
@@ -65,10 +67,13 @@ static void read_params(sim_t *s, cfg_t *cfg)
         char *dot = strrchr(p->name, '.');
         if (dot && dot != p->name) *dot = 0;
     }
-    if (cfg_has(cfg, "output", "dir"))
+    if (cfg_has(cfg, "output", "dir")) {
+        if (strlen(cfg_string(cfg, "output", "dir")) >= sizeof p->dir)
+            cfg_fail(cfg, "output", "dir", "the path is longer than %zu bytes", sizeof p->dir - 1);
         snprintf(p->dir, sizeof p->dir, "%s", cfg_string(cfg, "output", "dir"));
-    else
+    } else {
         snprintf(p->dir, sizeof p->dir, "out/%s", p->name);
+    }
     p->fields_every = cfg_double(cfg, "output", "fields_every");
     p->series_every = cfg_int(cfg, "output", "series_every");
     p->checkpoint_every = cfg_int(cfg, "output", "checkpoint_every");
@@ -240,7 +245,11 @@ static double stable_dt(sim_t *s)
 {
     double dt = INFINITY;
     for (int i = 0; i < s->npart; i++)
-        if (s->part[i].stable_dt) dt = fmin(dt, s->part[i].stable_dt(s->part[i].ctx));
+        if (s->part[i].stable_dt) {
+            const double l = s->part[i].stable_dt(s->part[i].ctx);
+            if (!(l > 0)) return l; /* zero, negative or not a number: no step (sim_run stops) */
+            dt = fmin(dt, l);
+        }
     for (int i = 0; i < s->npart; i++)
         if (s->part[i].align_dt) dt = fmin(dt, s->part[i].align_dt(s->part[i].ctx, dt));
     /* Land on t_end: a last step shortened (or slightly stretched, by less
@@ -306,6 +315,13 @@ static double progress_fraction(const sim_t *s)
  * wall clock, which rank 0 decides. */
 static sim_status_t stop_condition(sim_t *s)
 {
+    for (int i = 0; i < s->npart; i++) {
+        char why[400];
+        if (s->part[i].halt && s->part[i].halt(s->part[i].ctx, why, sizeof why)) {
+            snprintf(s->why, sizeof s->why, "%s: %s", s->part[i].name, why);
+            return SIM_HALTED;
+        }
+    }
     if (s->time >= s->prm.t_end) return SIM_T_END;
     for (int i = 0; i < s->npart; i++)
         if (s->part[i].done && s->part[i].done(s->part[i].ctx)) return SIM_DONE;
@@ -369,13 +385,14 @@ static void outputs(sim_t *s)
 
 static void write_summary(sim_t *s)
 {
-    static const char *status_name[] = {"running", "t_end", "max_steps", "wall_limit", "steady", "diverged", "done"};
+    static const char *status_name[] = {"running", "t_end",    "max_steps", "wall_limit",
+                                        "steady",  "diverged", "done",      "halted"};
     io_summary_t *y = s->summary;
     double wall = wtime() - s->wall0;
     io_summary_string(y, "case", s->prm.name);
     io_summary_string(y, "input", cfg_path(s->cfg));
     io_summary_string(y, "status", status_name[s->status]);
-    if (s->status == SIM_DIVERGED) io_summary_string(y, "reason", s->why);
+    if (s->status == SIM_DIVERGED || s->status == SIM_HALTED) io_summary_string(y, "reason", s->why);
     io_summary_string(y, "ibmdem_version", IBMDEM_VERSION);
     io_summary_long(y, "ranks", mpi_size());
     io_summary_long(y, "steps", s->step);
@@ -426,6 +443,38 @@ static int stop_diverged(sim_t *s)
     return 3;
 }
 
+/* No step can be taken: the time step the parts allow is zero, not a number,
+ * or too small to change the time.  The run stops as diverged, with a
+ * checkpoint of the state it is in (nothing was advanced). */
+static int stop_no_step(sim_t *s, double dt)
+{
+    const char *who = "the run driver";
+    double least = INFINITY;
+    for (int i = 0; i < s->npart; i++) {
+        const double l = s->part[i].stable_dt ? s->part[i].stable_dt(s->part[i].ctx) : INFINITY;
+        if (!(l >= least)) { /* the smallest limit, or the first that is not a number */
+            least = l;
+            who = s->part[i].name;
+            if (isnan(l)) break;
+        }
+    }
+    snprintf(s->why, sizeof s->why, "the time step is %g (limit of %s): the state cannot advance from t = %.10g", dt,
+             who, s->time);
+    io_progress_clear(&s->progress);
+    if (s->last_series_step != s->step) write_series_row(s);
+    write_checkpoint(s);
+    s->status = SIM_DIVERGED;
+    write_summary(s);
+    char text[2 * IO_PATH_MAX];
+    snprintf(text, sizeof text, "the run cannot go on at step %ld: %s\n  the state (step %ld, t = %.10g) is saved in %s\n",
+             s->step, s->why, s->step, s->time, s->last_checkpoint);
+    if (mpi_rank() == 0) {
+        fprintf(stderr, "error: %s", text);
+        if (s->out.log) fprintf(s->out.log, "error: %s", text);
+    }
+    return 3;
+}
+
 /* ---- the time loop ------------------------------------------------------------ */
 
 int sim_run(sim_t *s)
@@ -444,6 +493,7 @@ int sim_run(sim_t *s)
         /* 1. the time step: the most restrictive limit of every part
          *    (fluid: fluid_stable_dt, convective CFL and explicit viscous limit) */
         double dt = stable_dt(s);
+        if (!(dt > 0) || !isfinite(dt) || s->time + dt == s->time) return stop_no_step(s, dt);
         /* 2. advance every part by dt (fluid: fluid_step, three RK3 stages,
          *    each projected to a divergence-free velocity) */
         advance(s, dt);
@@ -458,6 +508,15 @@ int sim_run(sim_t *s)
     if (s->last_fields_step != s->step) write_fields(s);
     if (s->last_checkpoint_step != s->step) write_checkpoint(s);
     write_summary(s);
+    if (s->status == SIM_HALTED) {
+        if (mpi_rank() == 0) {
+            fprintf(stderr, "error: the run stopped at step %ld (t = %.10g): %s\n  its state is saved in %s\n",
+                    s->step, s->time, s->why, s->last_checkpoint);
+            if (s->out.log)
+                fprintf(s->out.log, "error: the run stopped at step %ld (t = %.10g): %s\n", s->step, s->time, s->why);
+        }
+        return 1;
+    }
     static const char *why[] = {"", "reached t_end", "reached max_steps", "reached the wall-time limit",
                                 "reached a steady state", "", "has what it was run for (a part is done)"};
     double wall = wtime() - s->wall0;

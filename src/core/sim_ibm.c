@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "ibm.h"
+#include "overlap.h"
 #include "sim.h"
 #include "util.h"
 
@@ -100,6 +101,59 @@ static int part_diverged(void *ctx, char *why, size_t n)
             }
     }
     return 0;
+}
+
+/* A free sphere touching a wall or another sphere: the immersed boundary
+ * has no contact model (the fluid alone would let it sink slowly through),
+ * so the run stops there (sim.h, halt).  Contacts need the DEM: spheres given
+ * as [particles] of a coupled scene. */
+static int part_halt(void *ctx, char *why, size_t n)
+{
+    ibm_part_t *ip = ctx;
+    const ibm_t *ibm = ip->ibm;
+    const grid_t *g = ibm->g;
+    static const char *face[3][2] = {{"x_lo", "x_hi"}, {"y_lo", "y_hi"}, {"z_lo", "z_hi"}};
+    int nfree = 0;
+    for (int p = 0; p < ibm->n; p++) {
+        const ibm_sphere_t *s = &ibm->s[p];
+        if (s->kind != IBM_FREE) continue;
+        nfree++;
+        for (int d = 0; d < g->dim; d++)
+            for (int side = 0; side < 2; side++) {
+                if (g->bc.type[d][side] == BC_PERIODIC || g->bc.type[d][side] == BC_AXIS) continue;
+                const double gap = side ? g->x0[d] + g->L[d] - (s->x[d] + s->radius) : s->x[d] - s->radius - g->x0[d];
+                if (gap < 0) {
+                    snprintf(why, n, "free sphere %d touched the %s wall (%c = %g, radius %g): immersed spheres have "
+                             "no contact model (give them one as [particles] of a coupled scene)", p + 1,
+                             face[d][side], "xyz"[d], s->x[d], s->radius);
+                    return 1;
+                }
+            }
+    }
+    if (nfree == 0 || ibm->n < 2) return 0;
+    overlap_box_t box = {.dim = g->dim};
+    double *x = xcalloc(3 * (size_t)ibm->n, sizeof(double)), *r = xcalloc((size_t)ibm->n, sizeof(double));
+    unsigned char *act = xcalloc((size_t)ibm->n, 1);
+    for (int d = 0; d < 3; d++) {
+        box.lo[d] = g->x0[d];
+        box.L[d] = g->L[d];
+        box.periodic[d] = g->periodic[d];
+    }
+    for (int p = 0; p < ibm->n; p++) {
+        memcpy(&x[3 * p], ibm->s[p].x, 3 * sizeof(double));
+        r[p] = ibm->s[p].radius;
+        act[p] = ibm->s[p].kind == IBM_FREE;
+    }
+    int i = 0, j = 0;
+    double delta = 0;
+    const int hit = overlap_find(&box, ibm->n, x, r, act, 0.0, &i, &j, &delta);
+    free(x);
+    free(r);
+    free(act);
+    if (hit)
+        snprintf(why, n, "spheres %d and %d touched (overlap %.3g): immersed spheres have no contact model (give them "
+                 "one as [particles] of a coupled scene)", i + 1, j + 1, delta);
+    return hit;
 }
 
 static void part_keep_previous(void *ctx)
@@ -395,6 +449,7 @@ struct ibm *sim_add_ibm_with(sim_t *s, cfg_t *cfg, const void *extra, int nextra
         .checkpoint_write = part_checkpoint_write,
         .checkpoint_read = part_checkpoint_read,
         .summary = part_summary,
+        .halt = part_halt,
         .destroy = part_destroy,
     };
     sim_add_part(s, &part);

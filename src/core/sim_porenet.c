@@ -36,6 +36,8 @@ typedef struct {
     double *xp, *rp;    /* the fixed packing read from porenet.packing */
     double q[6];
     double kappa[3];
+    cfg_t *cfg;
+    cfg_t *input;       /* until the first solve: a network that cannot be built from the input is bad input */
 } porenet_part_t;
 
 static const char *const pn_cols[] = {"porenet_q_in_max", "porenet_q_out_max", "porenet_p_max", "porenet_pores"};
@@ -68,7 +70,10 @@ static int read_packing_h5(cfg_t *cfg, const char *path, porenet_part_t *pp)
         cfg_fail(cfg, "porenet", "packing", "%s: position must hold 3 values per radius", path);
     H5Fclose(f);
     for (long i = 0; i < n; i++)
-        if (!(pp->rp[i] > 0)) cfg_fail(cfg, "porenet", "packing", "%s: radius %ld is not positive", path, i);
+        if (!(pp->rp[i] > 0) || !isfinite(pp->rp[i]) || !isfinite(pp->xp[3 * i]) || !isfinite(pp->xp[3 * i + 1]) ||
+            !isfinite(pp->xp[3 * i + 2]))
+            cfg_fail(cfg, "porenet", "packing", "%s: sphere %ld: the radius must be positive, every value finite", path,
+                     i + 1);
     return (int)n;
 }
 
@@ -77,26 +82,34 @@ static int read_packing_text(cfg_t *cfg, const char *path, porenet_part_t *pp)
 {
     FILE *f = fopen(path, "r");
     if (!f) cfg_fail(cfg, "porenet", "packing", "cannot open %s", path);
-    char line[1024];
+    char *line = NULL;
+    size_t lcap = 0;
     int cap = 1024, n = 0, ln = 0;
     pp->xp = malloc(3 * (size_t)cap * sizeof *pp->xp);
     pp->rp = malloc((size_t)cap * sizeof *pp->rp);
-    while (fgets(line, sizeof line, f)) {
+    while (getline(&line, &lcap, f) > 0) {
         ln++;
         char *s = line;
         while (*s == ' ' || *s == '\t') s++;
-        if (*s == '#' || *s == '\n' || *s == 0) continue;
+        if (*s == '#' || *s == '\n' || *s == '\r' || *s == 0) continue;
         if (n == cap) {
             cap *= 2;
             pp->xp = realloc(pp->xp, 3 * (size_t)cap * sizeof *pp->xp);
             pp->rp = realloc(pp->rp, (size_t)cap * sizeof *pp->rp);
         }
-        if (sscanf(s, "%lf %lf %lf %lf", pp->xp + 3 * n, pp->xp + 3 * n + 1, pp->xp + 3 * n + 2, pp->rp + n) != 4 ||
-            !(pp->rp[n] > 0))
-            cfg_fail(cfg, "porenet", "packing", "%s:%d: expected x y z r with r > 0", path, ln);
+        double v[4];
+        int k = 0;
+        char *save = NULL;
+        for (char *tok = strtok_r(s, " \t\r\n", &save); tok && k <= 4; tok = strtok_r(NULL, " \t\r\n", &save), k++)
+            if (k == 4 || !cfg_parse_real(tok, &v[k])) k = 5;
+        if (k != 4 || !(v[3] > 0))
+            cfg_fail(cfg, "porenet", "packing", "%s:%d: expected four numbers x y z r with r > 0", path, ln);
+        for (int c = 0; c < 3; c++) pp->xp[3 * n + c] = v[c];
+        pp->rp[n] = v[3];
         n++;
     }
     fclose(f);
+    free(line);
     return n;
 }
 
@@ -120,12 +133,20 @@ static void after_solve(porenet_part_t *pp)
 static void solve_now(porenet_part_t *pp, double dt)
 {
     if (pp->with_dem) {
-        if (pn_model_couple_dem(&pp->m, pp->d, pp->g, dt)) die("porenet: %s", pp->m.err);
+        if (pn_model_couple_dem(&pp->m, pp->d, pp->g, dt)) {
+            if (pp->input)
+                cfg_fail(pp->input, strstr(pp->m.err, "margin") ? "porenet" : "particles",
+                         strstr(pp->m.err, "margin") ? "margin" : "source",
+                         "the network of the first packing cannot be built: %s", pp->m.err);
+            die("porenet: %s", pp->m.err);
+        }
         pp->n = pp->m.n;
         pp->x = pp->m.xid;
         pp->r = pp->m.rid;
-    } else if (pn_model_step(&pp->m, pp->n, pp->x, pp->r, 0.0))
+    } else if (pn_model_step(&pp->m, pp->n, pp->x, pp->r, 0.0)) {
+        if (pp->input) cfg_fail(pp->input, "porenet", "packing", "%s", pp->m.err);
         die("porenet: %s", pp->m.err);
+    }
     after_solve(pp);
 }
 
@@ -136,7 +157,9 @@ static void ensure_started(porenet_part_t *pp)
     if (pp->started) return;
     pp->started = 1;
     if (pp->with_dem) pp->d = sim_dem_engine(pp->sim);
+    pp->input = pp->cfg;
     solve_now(pp, 0.0);
+    pp->input = NULL;
     double re, sr, por;
     char wbuf[1024];
     if (pn_model_validity(&pp->m, pp->r, wbuf, sizeof wbuf, &re, &sr, &por)) warn("porenet: outside the model's validity:\n%s", wbuf);
@@ -257,6 +280,7 @@ void sim_add_porenet(sim_t *s, cfg_t *cfg)
 {
     porenet_part_t *pp = xcalloc(1, sizeof *pp);
     pp->sim = s;
+    pp->cfg = cfg;
     pn_model_from_config(cfg, &pp->m);
     pp->with_dem = cfg_has_section(cfg, "particles");
     if (pp->with_dem) {
@@ -268,6 +292,16 @@ void sim_add_porenet(sim_t *s, cfg_t *cfg)
         for (int f = 0; f < 6; f++)
             if ((cfg_enum(cfg, "boundary", fn[f]) == 0) != pp->m.dom.periodic[f / 2])
                 cfg_fail(cfg, "porenet", fn[f], "must be periodic exactly when boundary.%s is (the DEM's face)", fn[f]);
+        /* the network's images of the spheres must fit in the box (pn_triangulate) */
+        const dem_t *d = sim_dem_engine_unprepared(s);
+        double rmax = 0;
+        for (int i = 0; d && i < dem_count(d); i++) rmax = fmax(rmax, dem_radii(d)[i]);
+        const double margin = pp->m.margin > 0 ? pp->m.margin : 6 * rmax;
+        for (int a = 0; a < 3; a++)
+            if (margin >= pp->m.dom.hi[a] - pp->m.dom.lo[a])
+                cfg_fail(cfg, pp->m.margin > 0 ? "porenet" : "domain", pp->m.margin > 0 ? "margin" : "length",
+                         "the box length along %c (%g) is not larger than the network's image margin %g%s", 'x' + a,
+                         pp->m.dom.hi[a] - pp->m.dom.lo[a], margin, pp->m.margin > 0 ? "" : " (3 largest diameters)");
     } else {
         read_packing(cfg, pp);
         ensure_started(pp);

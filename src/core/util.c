@@ -5,11 +5,14 @@
 #include <errno.h>
 #include <mpi.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <time.h>
+#include <unistd.h>
+#include <math.h>
 
 int mpi_rank(void)
 {
@@ -104,6 +107,7 @@ void die_local(const char *fmt, ...)
 
 void *xcalloc(size_t n, size_t size)
 {
+    if (size > 0 && n > SIZE_MAX / size) die_local("out of memory (%zu × %zu bytes)", n, size);
     size_t bytes = n * size;
     if (bytes == 0) bytes = 64;
     void *p = NULL;
@@ -134,6 +138,12 @@ long peak_rss_bytes(void)
         }
     fclose(f);
     return kb < 0 ? -1 : kb * 1024;
+}
+
+double physical_memory_bytes(void)
+{
+    const long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGESIZE);
+    return pages > 0 && size > 0 ? (double)pages * (double)size : INFINITY;
 }
 
 int mkdir_p(const char *path)

@@ -257,7 +257,13 @@ int io_is_h5_path(const char *path)
 
 hid_t io_h5_open_packing(cfg_t *cfg, const char *section, const char *key, const char *path, long *n)
 {
+    /* a missing or foreign file is an input error: without HDF5's error stack */
+    H5E_auto2_t func;
+    void *data;
+    H5Eget_auto2(H5E_DEFAULT, &func, &data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    H5Eset_auto2(H5E_DEFAULT, func, data);
     if (f < 0) cfg_fail(cfg, section, key, "cannot open %s as HDF5", path);
     if (H5Lexists(f, "radius", H5P_DEFAULT) <= 0 || H5Lexists(f, "position", H5P_DEFAULT) <= 0)
         cfg_fail(cfg, section, key, "%s: needs the datasets position [n][3] and radius [n]", path);

@@ -42,15 +42,21 @@ void io_summary_string(io_summary_t *s, const char *key, const char *v)
     size_t cap = 2 * strlen(v) + 8 * 6 + 3, n = 0;
     char *out = malloc(cap);
     out[n++] = '"';
+    /* JSON is UTF-8: a byte that is not (a file name may hold any) is U+FFFD */
+    const size_t len = strlen(v);
     for (const unsigned char *c = (const unsigned char *)v; *c; c++) {
         if (n + 8 > cap) out = realloc(out, cap *= 2);
+        const size_t u = cfg_utf8_char((const char *)c, len - (size_t)(c - (const unsigned char *)v));
         if (*c == '"' || *c == '\\') {
             out[n++] = '\\';
             out[n++] = (char)*c;
-        } else if (*c < 0x20) {
+        } else if (*c < 0x20 || *c == 0x7F) {
             n += (size_t)sprintf(out + n, "\\u%04x", *c);
+        } else if (u == 0) {
+            n += (size_t)sprintf(out + n, "\\ufffd");
         } else {
-            out[n++] = (char)*c;
+            for (size_t k = 0; k < u; k++) out[n++] = (char)c[k];
+            c += u - 1;
         }
     }
     out[n++] = '"';
