@@ -10,6 +10,10 @@ code refuses"):
          (a part halted the run: a message and summary status "halted");
 
 never a signal, a sanitizer report, a hang (timeouts) or another status.
+Each process gets --memory GB of address space (4 by default; under the
+sanitizers their allocations are capped instead): input that passes the
+checks but needs more (the checks refuse what exceeds the machine's memory)
+ends with "out of memory", status 1, which counts as clean.
 
 Every case file of cases/ is the start of its mutants (its grid shrunk to a
 few cells for speed): lines deleted, duplicated, swapped, indented or cut;
@@ -306,6 +310,8 @@ def judge(kind, rc, out, err, path, outdir):
         return "crash or sanitizer report: %s" % CRASH.search(err + out).group()
     if rc == 2:
         return None if input_error(path, err) else "status 2 without a message naming %s" % path
+    if rc == 1 and re.search(r"^error \(rank 0\): out of memory", err, re.M):
+        return None  # the address-space limit of this harness (--memory), with its message
     if kind == "check":
         if rc == 0:
             return None if "; check: valid on" in out else "status 0 without the resolved input"

@@ -47,8 +47,9 @@ static int run_with_limit(double lim, const char *name, long *step, char *status
     *step = s->step;
     char path[300];
     snprintf(path, sizeof path, "%s/summary.json", dir);
-    FILE *f = fopen(path, "r");
-    status[0] = 0;
+    MPI_Barrier(MPI_COMM_WORLD);
+    FILE *f = mpi_rank() == 0 ? fopen(path, "r") : NULL;
+    memset(status, 0, 64);
     if (f) {
         char buf[4096];
         size_t n = fread(buf, 1, sizeof buf - 1, f);
@@ -58,9 +59,12 @@ static int run_with_limit(double lim, const char *name, long *step, char *status
         if (k) sscanf(k + 11, "%63[^\"]", status);
     }
     (void)nstatus;
-    const int have_checkpoint = access(s->last_checkpoint, R_OK) == 0;
+    int have_checkpoint = access(s->last_checkpoint, R_OK) == 0;
     sim_free(s);
     cfg_free(cfg);
+    /* rank 0 wrote and read the files: every rank takes its answer (testutil.h) */
+    MPI_Bcast(&have_checkpoint, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    MPI_Bcast(status, 64, MPI_CHAR, 0, MPI_COMM_WORLD);
     return have_checkpoint ? rc : -rc - 100;
 }
 
