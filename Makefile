@@ -6,6 +6,8 @@
 #   make restitution  restitution sweeps of issue 5 (wall and binary; 1.3 min on 2 cores, measured in session 8);
 #                   RESTITUTION_SET='section.key=value ...' overrides keys in every run,
 #                   RESTITUTION_OUT=dir the output directory (default build/restitution)
+#   make fuzz       the long fuzz series of tests/fuzz.py (40 check and 8 run mutants of every case file;
+#                   FUZZ_SEED=N other mutants, FUZZ_ARGS='--checks 200' more); make test runs a quick subset
 #   make bench      benchmarks, results appended to docs/performance.md
 #   make deps       install missing Debian packages (apt-get)
 #   SANITIZE=1      build with AddressSanitizer + UBSan into build-san/
@@ -34,7 +36,7 @@ BIN     := $(BUILD)/ibmdem
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 BENCHES := $(patsubst bench/%.c,$(BUILD)/bench/%,$(wildcard bench/bench_*.c))
 
-.PHONY: all test demo validate bench deps clean restitution
+.PHONY: all test demo validate bench deps clean restitution fuzz
 all: $(BIN) $(TESTS) $(BENCHES)
 
 $(BUILD)/obj/%.o: src/%.c
@@ -92,6 +94,12 @@ RESTITUTION_OUT ?= $(BUILD)/restitution
 restitution: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bash scripts/restitution.sh $(RESTITUTION_OUT) full $(RESTITUTION_SET)
+
+# mutated case files through check and a few steps of run, clean outcomes only (part of make validate)
+FUZZ_SEED ?= 17
+fuzz: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	@/usr/bin/python3 tests/fuzz.py --bin $(BIN) --seed $(FUZZ_SEED) --checks 40 --runs 8 $(FUZZ_ARGS)
 
 clean:
 	rm -rf build build-san

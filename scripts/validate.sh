@@ -159,7 +159,7 @@ BUILD=$BUILD OUT=$OUT bash scripts/validate_coupling.sh || fail "coupling bounci
 section "permeability: resolved solver against the pore network on the same packing (issue 6)"
 BUILD=$BUILD OUT=$OUT bash scripts/permeability_crosscheck.sh || fail "permeability cross-check"
 
-# --- input: the long fuzz series (tests/fuzz.py; make test runs 3 check and 1 run mutants of
+# --- input: the long fuzz series (tests/fuzz.py; make test runs 1 check and 1 run mutant of
 # each case file): 40 check and 8 run mutants of every case file in cases/, clean outcomes only
 # (exit 0 with finite output, exit 2 naming the file and line, a clean divergence or halt; never
 # a signal, a sanitizer report or a hang).  FUZZ_SEED=N draws other mutants.

@@ -74,4 +74,9 @@ timeout 300 $BIN run $T/settle.ini --out $T/osettle >$T/settle.out 2>&1; rc=$?
 [ $rc = 1 ] && grep -q "^error: the run stopped at step [0-9]* (t = .*): ibm: free sphere 1 touched the y_lo wall" $T/settle.out &&
     $PY -c "import json,sys; d=json.load(open('$T/osettle/summary.json')); sys.exit(d['status']!='halted' or d['time']>=5)"
 report $? "a free sphere reaching the bottom wall stops the run there (status $rc, want 1; summary status halted)"
+# the same for a particle of a coupled scene settling onto a face with no DEM wall
+printf "$coupled" | sed 's/velocity 1e200 0 0//; s/center 2 6 2/center 2 0.8 2/; s/^faces = y_lo$/faces = x_lo/' >$T/unwalled.ini
+timeout 300 $BIN run $T/unwalled.ini --out $T/ounwalled >$T/unwalled.out 2>&1; rc=$?
+[ $rc = 1 ] && grep -q "^error: the run stopped at step [0-9]* .*coupling: particle 1 touched the y_lo face of the fluid's domain, which has no DEM wall" $T/unwalled.out
+report $? "a coupled particle reaching a face without a DEM wall stops the run there (status $rc, want 1)"
 tap_end $T

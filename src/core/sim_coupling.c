@@ -279,6 +279,43 @@ static int part_done(void *ctx)
     }
 }
 
+/* A mobile particle crossing a face of the fluid's domain that has no DEM
+ * wall: the fluid alone would let it sink through (no contact law there).
+ * Returns its id + 1 (0: none) and the face. */
+static long unwalled_touch(const dem_t *d, const grid_t *g, const char **face_name)
+{
+    static const char *face[3][2] = {{"x_lo", "x_hi"}, {"y_lo", "y_hi"}, {"z_lo", "z_hi"}};
+    const double *x = dem_positions(d), *r = dem_radii(d);
+    const unsigned char *fixed = dem_fixed(d);
+    for (int a = 0; a < g->dim; a++)
+        for (int side = 0; side < 2; side++) {
+            if (g->bc.type[a][side] == BC_PERIODIC || g->bc.type[a][side] == BC_AXIS) continue;
+            const int w = dem_wall_find(d, face[a][side]);
+            if (w >= 0 && dem_wall_active(d, w)) continue;
+            const double plane = side ? g->x0[a] + g->L[a] : g->x0[a];
+            for (int i = 0; i < dem_count(d); i++)
+                if (!fixed[i] && (side ? plane - (x[3 * i + a] + r[i]) : x[3 * i + a] - r[i] - plane) < 0) {
+                    *face_name = face[a][side];
+                    return dem_ids(d)[i] + 1;
+                }
+        }
+    return 0;
+}
+
+/* Such a contact stops the run (sim.h, halt). */
+static int part_halt(void *ctx, char *why, size_t n)
+{
+    coupling_part_t *cp = ctx;
+    if (!cp->ibm) return 0;
+    setup(cp);
+    const char *face;
+    const long id = unwalled_touch(cp->d, cp->ibm->g, &face);
+    if (id)
+        snprintf(why, n, "particle %ld touched the %s face of the fluid's domain, which has no DEM wall (give it one "
+                 "with walls.faces)", id, face);
+    return id != 0;
+}
+
 static void part_destroy(void *ctx)
 {
     coupling_part_t *cp = ctx;
@@ -315,6 +352,11 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
     if (ibm && ibm->n > 0 && cfg_enum(cfg, "coupling", "added_mass") == 1)
         coupling_added_mass_init(&cp->am, ibm->n, cfg_double(cfg, "coupling", "added_mass_coefficient"));
     cp->stop_after = mode != RESTITUTION_OFF && cfg_bool(cfg, "coupling", "stop_after_rebound");
+    const char *face;
+    const long id = ibm ? unwalled_touch(sim_dem_engine_unprepared(s), ibm->g, &face) : 0;
+    if (id)
+        cfg_fail(cfg, "walls", "faces", "particle %ld crosses the %s face of the fluid's domain, which has no DEM wall: "
+                 "it would halt the run at once", id, face);
     sim_part_t part = {
         .name = "coupling",
         .ctx = cp,
@@ -328,6 +370,7 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
         .checkpoint_read = part_checkpoint_read,
         .summary = part_summary,
         .done = part_done,
+        .halt = part_halt,
         .destroy = part_destroy,
     };
     sim_add_part(s, &part);

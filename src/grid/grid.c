@@ -94,8 +94,10 @@ grid_t *grid_create_from_config(cfg_t *cfg, MPI_Comm comm)
         cfg_fail(cfg, "domain", "nx", "%d cells do not divide among %d ranks (slabs in x)", n[0], nranks);
     if (n[0] / nranks < 2)
         cfg_fail(cfg, "domain", "nx", "%d cells among %d ranks leaves fewer than 2 per rank", n[0], nranks);
-    if (n[1] < 2) cfg_fail(cfg, "domain", "ny", "at least 2 cells (got %d)", n[1]);
-    if (geom == GEOM_3D && n[2] < 2) cfg_fail(cfg, "domain", "nz", "at least 2 cells in 3-D (got %d)", n[2]);
+    /* one cell between walls leaves no unknown of the normal velocity */
+    for (int d = 1; d < (geom == GEOM_3D ? 3 : 2); d++)
+        if (n[d] < 2 && bc.type[d][0] != BC_PERIODIC)
+            cfg_fail(cfg, "domain", d == 1 ? "ny" : "nz", "at least 2 cells between walls (got %d)", n[d]);
     /* a grid no machine of this size holds: the fluid keeps at least 8 fields
      * of doubles (2-D: u, v, their two Runge-Kutta stores, p and a work
      * field; 3-D: 11), each of (nx/ranks + 2)(ny + 2)(nz + 2) values a rank */
