@@ -193,6 +193,9 @@ hid_t io_checkpoint_begin(const char *dir, const io_checkpoint_header_t *h, MPI_
  * rank after an I/O error (io_error: the temporary file is deleted, the
  * previous checkpoint stays the newest). */
 int io_checkpoint_end(hid_t file, const char *dir, long step, int keep, char *path, size_t npath, MPI_Comm comm);
+/* Rank 0: delete the oldest checkpoint_*.h5 of DIR beyond the `keep` newest
+ * (keep <= 0: none). */
+void io_checkpoint_prune(const char *dir, int keep);
 /* Open a checkpoint, read its header and check that every floating-point
  * dataset is finite.  Returns the file (close with io_h5_close), or stops
  * the run with a message naming the file (and the dataset) if it cannot be

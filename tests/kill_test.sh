@@ -8,11 +8,12 @@
 # IBMDEM_FAULT=POINT@STEP (the program leaves with _exit, as at a kill -9, at that point):
 #   checkpoint-data     the checkpoint's data written, the file not closed (incomplete)
 #   checkpoint-written  the checkpoint complete under its temporary name, not renamed
-#   checkpoint-renamed  renamed, the older checkpoints not yet pruned
+#   checkpoint-renamed  renamed, the older checkpoints not yet pruned (also at the last step)
 #   series-row          half a row of series.csv written and flushed
 # The other kills are kill -9 at a random moment of the time loop (a delay after the run
 # created series.csv, within the duration of the uninterrupted run's loop).
-#   KILL_TEST=long (scripts/validate.sh) kills each case 12 times at random, on 1 and 2 ranks;
+#   KILL_TEST=long (scripts/validate.sh) kills each case at the 5 points and 12 times at random,
+#   on 1 and 2 ranks;
 #   the default (make test) is the quick version: a small fluid case (cavity 16 x 16) and a
 #   small coupled case (the bouncing sphere at D/dx = 10), 4 + 3 kills.
 # Prints TAP lines.
@@ -24,7 +25,7 @@ RANDOM=17 # the same delays every time (the moments they hit vary with the machi
 CAV="cases/cavity/cavity.ini --set domain.nx=16 --set domain.ny=16 --set time.t_end=1000 --set time.steady_tol=0
      --set time.max_steps=300 --set output.checkpoint_every=40 --set output.fields_every=2 --set output.overwrite=true"
 BNC="cases/bouncing_sphere/bounce_axi.ini --set domain.nx=40 --set domain.ny=440 --set domain.x_uniform_cells=25
-     --set output.progress=off --set time.max_steps=120 --set output.checkpoint_every=25 --set output.fields_every=0.4
+     --set output.progress=off --set time.max_steps=120 --set output.checkpoint_every=20 --set output.fields_every=0.4
      --set output.overwrite=true"
 
 # go NP DIR ARGS...: one attempt (its exit status)
@@ -40,7 +41,13 @@ finish() {
     for attempt in 1 2 3; do
         local ck
         ck=$(ls $d/checkpoint_*.h5 2>/dev/null | tail -1)
-        if [ -n "$ck" ]; then go $np $d "$@" --restart $ck; else go $np $d "$@"; fi && return 0
+        if [ -n "$ck" ]; then
+            echo "#   restart from $(basename $ck)"
+            go $np $d "$@" --restart $ck && return 0
+        else
+            echo "#   no checkpoint yet: started again"
+            go $np $d "$@" && return 0
+        fi
     done
     return 1
 }
@@ -70,8 +77,8 @@ killed() {
     finish $np $d "$@"
 }
 
-check_case() { # name np args... : the uninterrupted run, then the kills
-    local name=$1 np=$2; shift 2
+check_case() { # name np end args... : the uninterrupted run (to step end), then the kills
+    local name=$1 np=$2 end=$3; shift 3
     local ref=$T/$name.np$np.ref t0 t1 dur rc
     go $np $ref "$@" &
     local pid=$!
@@ -84,12 +91,12 @@ check_case() { # name np args... : the uninterrupted run, then the kills
     dur=$(awk -v a=$t0 -v b=$t1 'BEGIN{print b - a}') # of its time loop
     local kills
     if [ "$MODE" = long ]; then
-        kills="checkpoint-data@80 checkpoint-written@80 checkpoint-renamed@80 series-row@90"
+        kills="checkpoint-data@80 checkpoint-written@80 checkpoint-renamed@80 series-row@90 checkpoint-renamed@$end"
         for i in $(seq 12); do kills="$kills $(awk -v r=$RANDOM -v d=$dur 'BEGIN{printf "%.3f", r / 32768 * d}')"; done
     elif [ "$name" = cavity ]; then
-        kills="checkpoint-data@80 checkpoint-written@120 series-row@90 $(awk -v r=$RANDOM -v d=$dur 'BEGIN{printf "%.3f", r / 32768 * d}')"
+        kills="checkpoint-data@80 checkpoint-renamed@$end series-row@90 $(awk -v r=$RANDOM -v d=$dur 'BEGIN{printf "%.3f", r / 32768 * d}')"
     else
-        kills="checkpoint-renamed@50 $(awk -v r=$RANDOM -v d=$dur 'BEGIN{printf "%.3f %.3f", r / 32768 * d, (32767 - r) / 32768 * d}')"
+        kills="checkpoint-written@60 $(awk -v r=$RANDOM -v d=$dur 'BEGIN{printf "%.3f %.3f", r / 32768 * d, (32767 - r) / 32768 * d}')"
     fi
     local k=0
     for how in $kills; do
@@ -101,10 +108,10 @@ check_case() { # name np args... : the uninterrupted run, then the kills
     done
 }
 
-check_case cavity 1 $CAV
-check_case bounce 1 $BNC
+check_case cavity 1 300 $CAV
+check_case bounce 1 120 $BNC
 if [ "$MODE" = long ]; then
-    check_case cavity 2 $CAV
-    check_case bounce 2 $BNC
+    check_case cavity 2 300 $CAV
+    check_case bounce 2 120 $BNC
 fi
 tap_end "$T"

@@ -97,7 +97,7 @@ if mount -t tmpfs -o size=64k tmpfs $F 2>/dev/null; then
     rc=$?
     [ $rc = 1 ] && grep -q "error (rank [01]): cannot write .*HDF5 file $F/o/fields_0.*\.h5" $T/f2.log
     report $? "HDF5 snapshots on a full file system, 2 ranks: exit $rc, no hang, the file named"
-    umount $F
+    umount -l $F
 else
     echo "ok $((n + 1)) - # SKIP a full file system needs mount (tmpfs) permission"; n=$((n + 1))
     echo "ok $((n + 1)) - # SKIP a full file system needs mount (tmpfs) permission"; n=$((n + 1))

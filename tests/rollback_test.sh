@@ -4,7 +4,7 @@
 #     "diverged") stops with status 3 and the checkpoint of step N-1; restarted from it with
 #     the same input it leaves the same folder as the uninterrupted run (every output, bit for
 #     bit: tests/compare_runs.py) — fluid (cavity), immersed sphere (settling, axisymmetric),
-#     DEM alone (inclined plane), resolved coupling (bouncing sphere), pore network with DEM
+#     DEM alone (inclined plane, on 1 and 2 ranks), resolved coupling (bouncing sphere), pore network with DEM
 #     (deposition; step 89 re-triangulates, so its undoing rebuilds the network);
 #  2. a coupled run that really diverges (the DEM's overlap limit at the contact) saves the
 #     state at the start of the failed step: the checkpoint equals the uninterrupted run's at
@@ -27,21 +27,24 @@ PNT="cases/porenet_deposition/coarse.ini"
 OUT="--set output.fields_every=0.05 --set output.checkpoint_keep=1"
 
 # 1. made to diverge at step N, restarted with the same input: the uninterrupted run
-rollback() { # name N args...
+rollback() { # name N args... (NP ranks)
     local name=$1 N=$2; shift 2
-    local d=$T/$name E=$((N + 6))
-    IBMDEM_FAULT=diverge@$N $BIN run "$@" $OUT --set time.max_steps=$E --out $d >$d.log 2>&1
+    local d=$T/$name E=$((N + 6)) run="$BIN run"
+    [ "${NP:-1}" = 1 ] || run="$MPIRUN -np $NP $BIN run"
+    IBMDEM_FAULT=diverge@$N $run "$@" $OUT --set time.max_steps=$E --out $d >$d.log 2>&1
     local rc=$?
     local ck=$d/$(printf "checkpoint_%08d.h5" $((N - 1)))
+    grep -q "the run diverged at step $N " $d.log && rc=3 # (mpirun's status is its own)
     [ $rc = 3 ] && [ -e $ck ] && grep -q "the state at the start of that step (step $((N - 1))" $d.log &&
-        $BIN run "$@" $OUT --set time.max_steps=$E --out $d --restart $ck >>$d.log 2>&1 &&
-        $BIN run "$@" $OUT --set time.max_steps=$E --out $d.straight >$d.straight.log 2>&1 &&
+        $run "$@" $OUT --set time.max_steps=$E --out $d --restart $ck >>$d.log 2>&1 &&
+        $run "$@" $OUT --set time.max_steps=$E --out $d.straight >$d.straight.log 2>&1 &&
         $PY tests/compare_runs.py $d $d.straight
     report $? "$name: diverged at step $N (exit $rc), the state of step $((N - 1)) kept; restarted from it, the folder is the uninterrupted run's"
 }
 rollback fluid 15 $CAV
 rollback ibm 8 $SET
 rollback dem 25 $DEM
+NP=2 rollback dem_np2 25 $DEM
 rollback coupled 30 $BNC
 rollback porenet 89 $PNT
 

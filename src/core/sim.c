@@ -215,6 +215,7 @@ static void read_checkpoint(sim_t *s, const char *path)
      * unfinished ones went when the folder was opened); the parts delete
      * their own snapshots after theirs */
     io_outdir_remove_numbered(&s->out, "checkpoint_", ".h5", s->step + 1);
+    io_checkpoint_prune(s->out.dir, s->prm.checkpoint_keep); /* a run killed before it pruned */
     for (int i = 0; i < s->npart; i++) {
         sim_part_t *p = &s->part[i];
         if (!p->checkpoint_read) continue;

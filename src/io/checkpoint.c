@@ -49,8 +49,9 @@ static int cmp_step(const void *a, const void *b)
 }
 
 /* Delete the oldest checkpoints of dir beyond the `keep` newest. */
-static void prune(const char *dir, int keep)
+void io_checkpoint_prune(const char *dir, int keep)
 {
+    if (keep <= 0 || mpi_rank() != 0) return;
     DIR *d = opendir(dir);
     if (!d) return;
     ckpt_entry_t *list = NULL;
@@ -102,7 +103,7 @@ int io_checkpoint_end(hid_t file, const char *dir, long step, int keep, char *pa
     MPI_Bcast(&err, 1, MPI_INT, 0, comm);
     if (err) return -1;
     fault_point("checkpoint-renamed", step);
-    if (rank == 0 && keep > 0) prune(dir, keep);
+    io_checkpoint_prune(dir, keep);
     if (path) snprintf(path, npath, "%s", final);
     return 0;
 }
