@@ -203,6 +203,7 @@ typedef struct {
     int vol_current;    /* vol holds the pore volumes at x_prev on the current topology (the next step's start) */
     double *f, *fp, *fv; /* fp, fv: filled by pn_write_snapshot only */
     double *x_cont;     /* previous positions continuous with the current ones (periodic unwrapping) */
+    double *x_tri;      /* 3n: the positions the current triangulation was built from (exact restarts) */
     double *xid, *rid;  /* DEM coupling: positions / radii in the order of the particle ids (couple.c) */
     double dt_factor;   /* ζ of the coupled time step (thesis 4.21) */
     int dem_steps;      /* DEM steps per coupled step (multi-rate), within ζ Δt_{M−V} */
@@ -242,6 +243,12 @@ struct dem;
  * pressures; the model's forces act through the centres: zero torque).
  * dt <= 0: rigid skeleton (the initial state).  0 or -1 (m->err). */
 int pn_model_couple_dem(pn_model_t *m, struct dem *d, const double g[3], double dt);
+/* The particle positions and radii in the order of their ids into m->xid,
+ * m->rid. */
+void pn_model_gather_dem(pn_model_t *m, const struct dem *d);
+/* The fluid forces of the model's last step (m->f) to the DEM, as
+ * pn_model_couple_dem leaves them (a restart: no new solve). */
+void pn_model_forces_to_dem(pn_model_t *m, struct dem *d, const double g[3]);
 /* Time-step limit of the coupled problem, ζ · min_k Δt_{M−V} with the viscous
  * limit of each mobile particle Δt_{M−V} = π ρ_k d_k²/(1200 μ) = M_k/(200 μ d_k)
  * (thesis 4.19–4.22, β = 400 calibrated for d_max/d_min ≤ 10). */
@@ -268,5 +275,7 @@ int pn_model_validity(const pn_model_t *m, const double *r, char *buf, size_t nb
  * tetrahedra are those of the pores, the halves of the wall pores outside the
  * box included (each carries its pore's pressure). */
 void pn_write_snapshot(pn_model_t *m, const double *x, const char *dir, double time);
+/* Rank 0: rewrite DIR/porenet.xmf for the snapshots listed in m (a restart). */
+void pn_write_index(const pn_model_t *m, const char *dir);
 
 #endif

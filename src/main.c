@@ -100,6 +100,15 @@ static int usage_error(const char *fmt, const char *arg)
 
 int main(int argc, char **argv)
 {
+#ifdef OPEN_MPI
+    /* Open MPI's MPI-IO (OMPIO, under parallel HDF5) asks its shared-file-
+     * pointer components about every file it opens; the "lockedfile" one
+     * copies the file name into a 256-byte buffer, which a path of 245
+     * characters or more overflows (Open MPI 4.1: the process aborts).
+     * ibmdem never uses shared file pointers: that component is left out,
+     * unless the user chose the components (then paths must stay shorter). */
+    setenv("OMPI_MCA_sharedfp", "^lockedfile", 0);
+#endif
     MPI_Init(&argc, &argv);
     modules_register_keys();
     const char *cmd = argc >= 2 ? argv[1] : "";
@@ -168,6 +177,7 @@ int main(int argc, char **argv)
     sim_t *s = sim_create(cfg, restart, !run);
     int status = 0;
     if (run) {
+        sim_set_command(s, argc, argv);
         status = sim_run(s);
     } else if (mpi_rank() == 0) {
         cfg_write_resolved(cfg, stdout);
@@ -176,6 +186,5 @@ int main(int argc, char **argv)
     sim_free(s);
     cfg_free(cfg);
     free(sets);
-    MPI_Finalize();
-    return status;
+    mpi_finish(status);
 }

@@ -68,6 +68,10 @@ typedef struct {
     coupling_added_mass_t am; /* [coupling] added_mass = consistent (am.n > 0) */
     double wall_dem;     /* wall time in the DEM */
     long substeps;       /* DEM sub-steps done */
+    /* the state at the start of the step (rollback) */
+    restitution_t prev_rest;
+    double *prev_fz, *prev_dU; /* F0, J, held (13n); dU (3n) */
+    long prev_substeps;
 } coupling_part_t;
 
 static const char *const rest_cols[] = {"approach_speed", "lubrication_force"};
@@ -179,6 +183,41 @@ static int part_diverged(void *ctx, char *why, size_t n)
     return 1;
 }
 
+/* The state at the start of the step, and back (the DEM and the spheres
+ * are brought back by their own parts). */
+static void part_keep_previous(void *ctx)
+{
+    coupling_part_t *cp = ctx;
+    const size_t n = (size_t)cp->fz.n, na = (size_t)cp->am.n;
+    cp->prev_rest = cp->rest;
+    cp->prev_substeps = cp->substeps;
+    if (n) {
+        if (!cp->prev_fz) cp->prev_fz = xcalloc(13 * n, sizeof(double));
+        memcpy(cp->prev_fz, cp->fz.F0, 6 * n * sizeof(double));
+        memcpy(cp->prev_fz + 6 * n, cp->fz.J, 6 * n * sizeof(double));
+        memcpy(cp->prev_fz + 12 * n, cp->fz.held, n * sizeof(double));
+    }
+    if (na) {
+        if (!cp->prev_dU) cp->prev_dU = xcalloc(3 * na, sizeof(double));
+        memcpy(cp->prev_dU, cp->am.dU, 3 * na * sizeof(double));
+    }
+}
+
+static void part_restore_previous(void *ctx)
+{
+    coupling_part_t *cp = ctx;
+    const size_t n = (size_t)cp->fz.n, na = (size_t)cp->am.n;
+    cp->rest = cp->prev_rest;
+    cp->substeps = cp->prev_substeps;
+    cp->status = DEM_OK;
+    if (n && cp->prev_fz) {
+        memcpy(cp->fz.F0, cp->prev_fz, 6 * n * sizeof(double));
+        memcpy(cp->fz.J, cp->prev_fz + 6 * n, 6 * n * sizeof(double));
+        memcpy(cp->fz.held, cp->prev_fz + 12 * n, n * sizeof(double));
+    }
+    if (na && cp->prev_dU) memcpy(cp->am.dU, cp->prev_dU, 3 * na * sizeof(double));
+}
+
 /* The tracker's state (exact restarts of the measurements). */
 #define REST_NSTATE 10
 static void pack(const restitution_t *r, double *v)
@@ -194,6 +233,7 @@ static void part_checkpoint_write(void *ctx, hid_t grp)
     double v[REST_NSTATE];
     pack(&cp->rest, v);
     io_h5_write_array(grp, "restitution", REST_NSTATE, v);
+    io_h5_attr_long(grp, "dem_substeps", cp->substeps);
     if (cp->fz.n) {
         io_h5_write_array(grp, "freeze_force", 6L * cp->fz.n, cp->fz.F0);
         io_h5_write_array(grp, "freeze_impulse", 6L * cp->fz.n, cp->fz.J);
@@ -212,6 +252,7 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
     r->phase = (int)v[0];
     r->u_last = v[1], r->VT = v[2], r->VC = v[3], r->VR = v[4], r->VR_release = v[5];
     r->t_contact = v[6], r->t_release = v[7], r->lub_impulse = v[8], r->VC_onset = v[9];
+    if (io_h5_get_attr_long(grp, "dem_substeps", &cp->substeps)) cp->substeps = 0;
     if (cp->fz.n) {
         const long n = cp->fz.n;
         if (io_h5_read_array(grp, "freeze_force", 6 * n, cp->fz.F0) != 6 * n ||
@@ -321,6 +362,8 @@ static void part_destroy(void *ctx)
     coupling_part_t *cp = ctx;
     coupling_freeze_free(&cp->fz);
     coupling_added_mass_free(&cp->am);
+    free(cp->prev_fz);
+    free(cp->prev_dU);
     free(cp);
 }
 
@@ -366,6 +409,8 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
         .col_names = rest_cols,
         .diagnostics = part_diagnostics,
         .diverged = part_diverged,
+        .keep_previous = part_keep_previous,
+        .restore_previous = part_restore_previous,
         .checkpoint_write = part_checkpoint_write,
         .checkpoint_read = part_checkpoint_read,
         .summary = part_summary,

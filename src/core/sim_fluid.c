@@ -17,6 +17,8 @@ typedef struct {
     double *prev[4];      /* u, v, w, p at the start of the step (rollback) */
     double prev_time;
     long prev_step;
+    fluid_diag_t prev_diag; /* the diagnostics of the step before */
+    int prev_stepped;
     double ke_now, ke_prev; /* kinetic energy after and before the last step */
     double div_init;      /* max |div u| of the initial state */
     int stepped;          /* a step was taken in this run */
@@ -104,6 +106,8 @@ static void part_keep_previous(void *ctx)
     }
     fp->prev_time = f->time;
     fp->prev_step = f->step;
+    fp->prev_diag = f->diag;
+    fp->prev_stepped = fp->stepped;
 }
 
 static void part_restore_previous(void *ctx)
@@ -116,6 +120,8 @@ static void part_restore_previous(void *ctx)
     }
     f->time = fp->prev_time;
     f->step = fp->prev_step;
+    f->diag = fp->prev_diag;
+    fp->stepped = fp->prev_stepped;
     fp->ke_now = fp->ke_prev;
 }
 
@@ -163,6 +169,9 @@ static void part_checkpoint_write(void *ctx, hid_t grp)
     io_h5_attr_double(grp, "time", f->time);
     io_h5_attr_long(grp, "step", f->step);
     io_h5_attr_long(grp, "snapshots", fp->snaps ? io_snapshots_count(fp->snaps) : fp->snap_first);
+    /* the diagnostics of the last step (a restart that takes no step reports them) */
+    const double diag[5] = {fp->stepped, f->diag.cfl, f->diag.div_max, f->diag.res_poisson, f->diag.it_poisson};
+    io_h5_write_array(grp, "last_step_diagnostics", 5, diag);
     io_h5_attr_string(grp, "layout", "interior of each staggered field, [nx][ny][nz], k fastest; "
                                      "u(i) on the high x face of cell i (CaNS convention)");
     for (int c = 0; c < 4; c++) {
@@ -241,10 +250,20 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
     if (io_h5_get_attr_double(grp, "time", &f->time) || io_h5_get_attr_long(grp, "step", &f->step))
         die("%s: /fluid has no time or step attribute", path);
     if (io_h5_get_attr_long(grp, "snapshots", &snaps) == 0) fp->snap_first = (int)snaps;
+    /* the snapshots the lost continuation wrote, and the index of ours */
+    io_outdir_remove_numbered(&fp->sim->out, "fields_", ".h5", fp->snap_first);
+    if (!fp->snaps) fp->snaps = io_snapshots_create(fp->g, fp->sim->out.dir, fp->snap_first);
+    io_snapshots_write_index(fp->snaps);
     fluid_apply_bc(f);
     fill_pressure_ghosts(fp->g, f->p);
     fp->ke_now = fluid_kinetic_energy(f);
     fp->div_init = fluid_max_divergence(f);
+    double diag[5];
+    if (io_h5_read_array(grp, "last_step_diagnostics", 5, diag) == 5) {
+        fp->stepped = diag[0] != 0;
+        f->diag.cfl = diag[1], f->diag.div_max = diag[2], f->diag.res_poisson = diag[3];
+        f->diag.it_poisson = (int)diag[4];
+    }
 }
 
 static void part_summary(void *ctx, io_summary_t *y, const char *prefix)

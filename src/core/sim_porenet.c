@@ -36,8 +36,15 @@ typedef struct {
     double *xp, *rp;    /* the fixed packing read from porenet.packing */
     double q[6];
     double kappa[3];
-    cfg_t *cfg;
-    cfg_t *input;       /* until the first solve: a network that cannot be built from the input is bad input */
+    cfg_t *cfg;         /* the input: a network that cannot be built from it at the start is bad input */
+    int failed;         /* the last step failed (m.err): the run diverged */
+    /* the state at the start of the step (rollback) */
+    struct {
+        long n_retri, n_steps;
+        int vol_current, npore, n;
+        double eps_acc, q[6], kappa[3];
+        double *p, *vol, *vol_prev, *x_prev, *f, *x_tri;
+    } prev;
 } porenet_part_t;
 
 static const char *const pn_cols[] = {"porenet_q_in_max", "porenet_q_out_max", "porenet_p_max", "porenet_pores"};
@@ -129,25 +136,20 @@ static void after_solve(porenet_part_t *pp)
     for (int a = 0; a < 3; a++) pp->kappa[a] = pn_model_permeability(&pp->m, a);
 }
 
-/* dt <= 0: the initial state (rigid skeleton) */
-static void solve_now(porenet_part_t *pp, double dt)
+/* dt <= 0: the initial state (rigid skeleton).  Returns 0, or -1 with the
+ * reason in pp->m.err. */
+static int solve_now(porenet_part_t *pp, double dt)
 {
     if (pp->with_dem) {
-        if (pn_model_couple_dem(&pp->m, pp->d, pp->g, dt)) {
-            if (pp->input)
-                cfg_fail(pp->input, strstr(pp->m.err, "margin") ? "porenet" : "particles",
-                         strstr(pp->m.err, "margin") ? "margin" : "source",
-                         "the network of the first packing cannot be built: %s", pp->m.err);
-            die("porenet: %s", pp->m.err);
-        }
+        if (pn_model_couple_dem(&pp->m, pp->d, pp->g, dt)) return -1;
         pp->n = pp->m.n;
         pp->x = pp->m.xid;
         pp->r = pp->m.rid;
     } else if (pn_model_step(&pp->m, pp->n, pp->x, pp->r, 0.0)) {
-        if (pp->input) cfg_fail(pp->input, "porenet", "packing", "%s", pp->m.err);
-        die("porenet: %s", pp->m.err);
+        return -1;
     }
     after_solve(pp);
+    return 0;
 }
 
 /* The first solve, once the particles exist (the DEM prepares its packing
@@ -157,9 +159,12 @@ static void ensure_started(porenet_part_t *pp)
     if (pp->started) return;
     pp->started = 1;
     if (pp->with_dem) pp->d = sim_dem_engine(pp->sim);
-    pp->input = pp->cfg;
-    solve_now(pp, 0.0);
-    pp->input = NULL;
+    if (solve_now(pp, 0.0)) {
+        if (!pp->with_dem) cfg_fail(pp->cfg, "porenet", "packing", "%s", pp->m.err);
+        const int margin = strstr(pp->m.err, "margin") != NULL;
+        cfg_fail(pp->cfg, margin ? "porenet" : "particles", margin ? "margin" : "source",
+                 "the network of the first packing cannot be built: %s", pp->m.err);
+    }
     double re, sr, por;
     char wbuf[1024];
     if (pn_model_validity(&pp->m, pp->r, wbuf, sizeof wbuf, &re, &sr, &por)) warn("porenet: outside the model's validity:\n%s", wbuf);
@@ -188,7 +193,7 @@ static void part_advance(void *ctx, double dt)
     porenet_part_t *pp = ctx;
     ensure_started(pp);
     /* fixed packing: the same steady solution (boundary values may change on restart) */
-    solve_now(pp, pp->with_dem ? dt : 0.0);
+    pp->failed = solve_now(pp, pp->with_dem ? dt : 0.0) != 0;
 }
 
 static void part_diagnostics(void *ctx, double *c)
@@ -209,12 +214,168 @@ static void part_diagnostics(void *ctx, double *c)
 static int part_diverged(void *ctx, char *why, size_t n)
 {
     porenet_part_t *pp = ctx;
+    if (pp->failed) {
+        snprintf(why, n, "%s", pp->m.err);
+        return 1;
+    }
     for (int i = 0; i < pp->m.net.npore; i++)
         if (!isfinite(pp->m.p[i])) {
             snprintf(why, n, "non-finite pore pressure");
             return 1;
         }
     return 0;
+}
+
+/* ---- the state: rollback and checkpoints ---- */
+
+static double *copy_of(double *dst, const double *src, size_t n)
+{
+    dst = realloc(dst, (n ? n : 1) * sizeof *dst);
+    if (n) memcpy(dst, src, n * sizeof *dst);
+    return dst;
+}
+
+static void part_keep_previous(void *ctx)
+{
+    porenet_part_t *pp = ctx;
+    ensure_started(pp);
+    pn_model_t *m = &pp->m;
+    const size_t np = (size_t)m->net.npore, n3 = 3 * (size_t)m->n;
+    pp->prev.n_retri = m->n_retri;
+    pp->prev.n_steps = m->n_steps;
+    pp->prev.vol_current = m->vol_current;
+    pp->prev.npore = m->net.npore;
+    pp->prev.n = m->n;
+    pp->prev.eps_acc = m->eps_acc;
+    memcpy(pp->prev.q, pp->q, sizeof pp->q);
+    memcpy(pp->prev.kappa, pp->kappa, sizeof pp->kappa);
+    pp->prev.p = copy_of(pp->prev.p, m->p, np);
+    pp->prev.vol = copy_of(pp->prev.vol, m->vol, np);
+    pp->prev.vol_prev = copy_of(pp->prev.vol_prev, m->vol_prev, np);
+    pp->prev.x_prev = copy_of(pp->prev.x_prev, m->x_prev, n3);
+    pp->prev.f = copy_of(pp->prev.f, m->f, n3);
+    pp->prev.x_tri = copy_of(pp->prev.x_tri, m->x_tri, n3);
+}
+
+/* The model's state from saved values: the triangulation, network and
+ * factorisation rebuilt from the positions they were built from when they
+ * are not those (then: the same, bit for bit), and the step's values. */
+static void set_state(porenet_part_t *pp, long n_retri, long n_steps, int vol_current, double eps_acc,
+                      const double *x_tri, const double *p, const double *vol, const double *vol_prev,
+                      const double *x_prev, const double *f)
+{
+    pn_model_t *m = &pp->m;
+    const int n = m->n;
+    const double *r = pp->with_dem ? m->rid : pp->r;
+    if (!m->built || !m->sol || n_retri != m->n_retri || memcmp(x_tri, m->x_tri, 3 * (size_t)n * sizeof *x_tri))
+        if (pn_model_rebuild(m, n, x_tri, r)) die("porenet: %s", m->err);
+    const size_t np = (size_t)m->net.npore, n3 = 3 * (size_t)n;
+    memcpy(m->p, p, np * sizeof *p);
+    memcpy(m->vol, vol, np * sizeof *vol);
+    memcpy(m->vol_prev, vol_prev, np * sizeof *vol_prev);
+    memcpy(m->x_prev, x_prev, n3 * sizeof *x_prev);
+    memcpy(m->f, f, n3 * sizeof *f);
+    m->n_retri = n_retri;
+    m->n_steps = n_steps;
+    m->vol_current = vol_current;
+    m->eps_acc = eps_acc;
+}
+
+static void part_restore_previous(void *ctx)
+{
+    porenet_part_t *pp = ctx;
+    set_state(pp, pp->prev.n_retri, pp->prev.n_steps, pp->prev.vol_current, pp->prev.eps_acc, pp->prev.x_tri,
+              pp->prev.p, pp->prev.vol, pp->prev.vol_prev, pp->prev.x_prev, pp->prev.f);
+    memcpy(pp->q, pp->prev.q, sizeof pp->q);
+    memcpy(pp->kappa, pp->prev.kappa, sizeof pp->kappa);
+    pp->failed = 0; /* the DEM part brought back its external forces */
+}
+
+static void part_checkpoint_write(void *ctx, hid_t grp)
+{
+    porenet_part_t *pp = ctx;
+    ensure_started(pp);
+    pn_model_t *m = &pp->m;
+    const long np = m->net.npore, n3 = 3L * m->n;
+    io_h5_attr_long(grp, "spheres", m->n);
+    io_h5_attr_long(grp, "pores", np);
+    io_h5_attr_long(grp, "triangulations", m->n_retri);
+    io_h5_attr_long(grp, "steps", m->n_steps);
+    io_h5_attr_long(grp, "volumes_current", m->vol_current);
+    io_h5_attr_double(grp, "strain_since_triangulation", m->eps_acc);
+    io_h5_attr_string(grp, "layout", "spheres in the order of the particle ids (the DEM's), pores in the order of "
+                                     "the network built from triangulation_positions");
+    io_h5_write_matrix(grp, "triangulation_positions", m->n, 3, m->x_tri);
+    io_h5_write_matrix(grp, "previous_positions", m->n, 3, m->x_prev);
+    io_h5_write_matrix(grp, "force", m->n, 3, m->f);
+    io_h5_write_array(grp, "pressure", np, m->p);
+    io_h5_write_array(grp, "pore_volume", np, m->vol);
+    io_h5_write_array(grp, "pore_volume_previous", np, m->vol_prev);
+    (void)n3;
+    io_h5_attr_long(grp, "snapshots", m->nsnap);
+    if (m->nsnap > 0) {
+        double *c = xcalloc(4 * (size_t)m->nsnap, sizeof *c);
+        for (long i = 0; i < 4L * m->nsnap; i++) c[i] = (double)m->snap_counts[i];
+        io_h5_write_array(grp, "snapshot_times", m->nsnap, m->snap_time);
+        io_h5_write_matrix(grp, "snapshot_counts", m->nsnap, 4, c);
+        free(c);
+    }
+}
+
+static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
+{
+    porenet_part_t *pp = ctx;
+    pn_model_t *m = &pp->m;
+    long n = 0, np = 0, nretri = 0, nsteps = 0, volc = 0, nsnap = 0;
+    double eps = 0;
+    if (io_h5_get_attr_long(grp, "spheres", &n) || io_h5_get_attr_long(grp, "pores", &np) ||
+        io_h5_get_attr_long(grp, "triangulations", &nretri) || io_h5_get_attr_long(grp, "steps", &nsteps) ||
+        io_h5_get_attr_long(grp, "volumes_current", &volc) ||
+        io_h5_get_attr_double(grp, "strain_since_triangulation", &eps) ||
+        io_h5_get_attr_long(grp, "snapshots", &nsnap))
+        die("%s: /porenet lacks the attributes of the model's state", path);
+    if (pp->with_dem) {
+        pp->d = sim_dem_engine(pp->sim); /* the particles come from the checkpoint */
+        if (n != dem_count(pp->d)) die("%s: /porenet holds %ld spheres, the DEM %d", path, n, dem_count(pp->d));
+        m->n = (int)n;
+    } else if (n != pp->n) {
+        die("%s: /porenet holds %ld spheres, porenet.packing %d", path, n, pp->n);
+    }
+    double *x_tri = xcalloc(3 * (size_t)n + 1, sizeof(double)), *x_prev = xcalloc(3 * (size_t)n + 1, sizeof(double));
+    double *f = xcalloc(3 * (size_t)n + 1, sizeof(double)), *p = xcalloc((size_t)np + 1, sizeof(double));
+    double *vol = xcalloc((size_t)np + 1, sizeof(double)), *vol_prev = xcalloc((size_t)np + 1, sizeof(double));
+    if (io_h5_read_array(grp, "triangulation_positions", 3 * n, x_tri) != 3 * n ||
+        io_h5_read_array(grp, "previous_positions", 3 * n, x_prev) != 3 * n ||
+        io_h5_read_array(grp, "force", 3 * n, f) != 3 * n || io_h5_read_array(grp, "pressure", np, p) != np ||
+        io_h5_read_array(grp, "pore_volume", np, vol) != np ||
+        io_h5_read_array(grp, "pore_volume_previous", np, vol_prev) != np)
+        die("%s: /porenet: a dataset of the model's state is missing or has the wrong size", path);
+    if (pp->with_dem) pn_model_gather_dem(m, pp->d); /* the radii in the model's order */
+    set_state(pp, nretri, nsteps, (int)volc, eps, x_tri, p, vol, vol_prev, x_prev, f);
+    if (m->net.npore != np) die("%s: /porenet holds %ld pores, the network rebuilt from it %d", path, np, m->net.npore);
+    if (pp->with_dem) {
+        pn_model_forces_to_dem(m, pp->d, pp->g); /* the forces of the step before the checkpoint */
+        pp->x = m->xid;
+        pp->r = m->rid;
+        pp->n = m->n;
+    }
+    after_solve(pp);
+    pp->started = 1;
+    free(x_tri), free(x_prev), free(f), free(p), free(vol), free(vol_prev);
+    /* the snapshots: the list of the earlier ones, without those the lost continuation wrote */
+    m->nsnap = (int)nsnap;
+    m->snap_time = realloc(m->snap_time, ((size_t)nsnap + 1) * sizeof *m->snap_time);
+    m->snap_counts = realloc(m->snap_counts, 4 * ((size_t)nsnap + 1) * sizeof *m->snap_counts);
+    if (nsnap > 0) {
+        double *c = xcalloc(4 * (size_t)nsnap, sizeof *c);
+        if (io_h5_read_array(grp, "snapshot_times", nsnap, m->snap_time) != nsnap ||
+            io_h5_read_array(grp, "snapshot_counts", 4 * nsnap, c) != 4 * nsnap)
+            die("%s: /porenet: the snapshot list is missing or has the wrong size", path);
+        for (long i = 0; i < 4 * nsnap; i++) m->snap_counts[i] = (long)c[i];
+        free(c);
+    }
+    io_outdir_remove_numbered(&pp->sim->out, "porenet_", ".h5", nsnap);
+    pn_write_index(m, pp->sim->out.dir);
 }
 
 static void part_write_fields(void *ctx, double time, long step)
@@ -270,6 +431,8 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
 static void part_destroy(void *ctx)
 {
     porenet_part_t *pp = ctx;
+    double *prev[] = {pp->prev.p, pp->prev.vol, pp->prev.vol_prev, pp->prev.x_prev, pp->prev.f, pp->prev.x_tri};
+    for (size_t i = 0; i < sizeof prev / sizeof prev[0]; i++) free(prev[i]);
     pn_model_free(&pp->m);
     free(pp->xp);
     free(pp->rp);
@@ -315,7 +478,11 @@ void sim_add_porenet(sim_t *s, cfg_t *cfg)
         .col_names = pn_cols,
         .diagnostics = part_diagnostics,
         .diverged = part_diverged,
+        .keep_previous = part_keep_previous,
+        .restore_previous = part_restore_previous,
         .write_fields = part_write_fields,
+        .checkpoint_write = part_checkpoint_write,
+        .checkpoint_read = part_checkpoint_read,
         .summary = part_summary,
         .destroy = part_destroy,
     };

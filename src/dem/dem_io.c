@@ -32,14 +32,32 @@ static hid_t open_file(const dem_t *d, const char *path, int create)
     return f;
 }
 
+/* Close a file written: flushed to the disk first (MPI_File_sync); a failure
+ * is an I/O error (util.h). */
+static void close_written(hid_t f, const char *path)
+{
+    const int flush_failed = H5Fflush(f, H5F_SCOPE_GLOBAL) < 0;
+    const int close_failed = H5Fclose(f) < 0;
+    if (close_failed) mpi_finalize_unsafe(); /* the file is left half closed (HDF5 1.10) */
+    if (close_failed || flush_failed) io_error_collective("cannot write the HDF5 file %s (HDF5 error, see above)", path);
+}
+
+/* A dataset or attribute not written: an I/O error naming its file. */
+static void write_failed(hid_t loc, const char *name)
+{
+    char file[4096] = "?";
+    H5Fget_name(loc, file, sizeof file);
+    io_error_collective("cannot write %s in the HDF5 file %s (HDF5 error, see above)", name, file);
+}
+
 /* Collective creation, rank-0 write of an n×comp dataset. */
 static void write_ds(const dem_t *d, hid_t file, const char *name, hid_t type, const void *data, long n, int comp)
 {
     hsize_t dims[2] = {(hsize_t)n, (hsize_t)comp};
     hid_t sp = H5Screate_simple(comp > 1 ? 2 : 1, dims, NULL);
     hid_t ds = H5Dcreate2(file, name, type, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    if (ds < 0) die("dem: cannot create dataset %s", name);
-    if (d->rank == 0 && n > 0) H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+    if (ds < 0 || (d->rank == 0 && n > 0 && H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0))
+        write_failed(file, name);
     H5Dclose(ds);
     H5Sclose(sp);
 }
@@ -49,7 +67,7 @@ static void write_attr_d(hid_t obj, const char *name, const double *v, int n)
     hsize_t dims = (hsize_t)n;
     hid_t sp = H5Screate_simple(1, &dims, NULL);
     hid_t a = H5Acreate2(obj, name, H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT);
-    H5Awrite(a, H5T_NATIVE_DOUBLE, v);
+    if (a < 0 || H5Awrite(a, H5T_NATIVE_DOUBLE, v) < 0) write_failed(obj, name);
     H5Aclose(a);
     H5Sclose(sp);
 }
@@ -58,7 +76,7 @@ static void write_attr_l(hid_t obj, const char *name, long v)
 {
     hid_t sp = H5Screate(H5S_SCALAR);
     hid_t a = H5Acreate2(obj, name, H5T_NATIVE_LONG, sp, H5P_DEFAULT, H5P_DEFAULT);
-    H5Awrite(a, H5T_NATIVE_LONG, &v);
+    if (a < 0 || H5Awrite(a, H5T_NATIVE_LONG, &v) < 0) write_failed(obj, name);
     H5Aclose(a);
     H5Sclose(sp);
 }
@@ -172,10 +190,10 @@ static void snap_record(dem_t *d, int index, double t, long n)
 static void write_xdmf(dem_t *d, const char *dir)
 {
     if (d->rank != 0) return;
-    char path[4096];
+    char path[4096], tmp[4112];
     snprintf(path, sizeof path, "%s/particles.xdmf", dir);
-    FILE *fp = fopen(path, "w");
-    if (!fp) die_local("cannot write %s", path);
+    FILE *fp = atomic_open(path, tmp, sizeof tmp);
+    if (!fp) return;
     fprintf(fp, "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"3.0\">\n<Domain>\n"
                 "<Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
     for (int s = 0; s < d->nsnap; s++) {
@@ -204,7 +222,7 @@ static void write_xdmf(dem_t *d, const char *dir)
                 n, base, n, base, n, base);
     }
     fprintf(fp, "</Grid>\n</Domain>\n</Xdmf>\n");
-    fclose(fp);
+    atomic_commit(fp, tmp, path);
 }
 
 void dem_snapshots_resume(dem_t *d, const char *dir, int first)
@@ -220,6 +238,7 @@ void dem_snapshots_resume(dem_t *d, const char *dir, int first)
         H5Fclose(f);
         snap_record(d, k, t, n);
     }
+    write_xdmf(d, dir); /* the index of these only */
 }
 
 void dem_write_snapshot(dem_t *d, const char *dir, int index)
@@ -231,7 +250,7 @@ void dem_write_snapshot(dem_t *d, const char *dir, int index)
     write_attr_d(f, "time", &d->time, 1);
     write_attr_l(f, "step", d->step);
     write_particles(d, f, 0);
-    H5Fclose(f);
+    close_written(f, path);
     snap_record(d, index, d->time, d->n);
     write_xdmf(d, dir);
 }
@@ -240,7 +259,7 @@ void dem_write_checkpoint(dem_t *d, const char *path)
 {
     hid_t f = open_file(d, path, 1);
     dem_checkpoint_write_loc(d, f);
-    H5Fclose(f);
+    close_written(f, path);
 }
 
 void dem_checkpoint_write_loc(dem_t *d, hid_t f)
@@ -683,8 +702,9 @@ void dem_write_lammps_data(dem_t *d, const char *path)
 {
     dem_sync_velocities(d);
     if (d->rank != 0) return;
-    FILE *fp = fopen(path, "w");
-    if (!fp) die_local("cannot write %s", path);
+    char tmp[4112];
+    FILE *fp = atomic_open(path, tmp, sizeof tmp);
+    if (!fp) die_local("%s", io_error_message());
     int *o = id_order(d);
     fprintf(fp, "ibmdem DEM state at t = %.10g s\n\n%d atoms\n1 atom types\n\n", d->time, d->n);
     const char *ax = "xyz";
@@ -701,6 +721,6 @@ void dem_write_lammps_data(dem_t *d, const char *path)
         fprintf(fp, "%d %.6e %.6e %.6e %.6e %.6e %.6e\n", k + 1, d->v[3 * i], d->v[3 * i + 1], d->v[3 * i + 2],
                 d->w[3 * i], d->w[3 * i + 1], d->w[3 * i + 2]);
     }
-    fclose(fp);
     free(o);
+    if (atomic_commit(fp, tmp, path)) die_local("%s", io_error_message());
 }

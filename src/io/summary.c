@@ -152,7 +152,8 @@ static void write_object(FILE *f, sum_entry_t **e, int n, int depth)
 int io_summary_write(const io_summary_t *s, const char *path)
 {
     if (mpi_rank() != 0) return 0;
-    FILE *f = fopen(path, "w");
+    char tmp[IO_PATH_MAX + 80];
+    FILE *f = atomic_open(path, tmp, sizeof tmp);
     if (!f) return -1;
     sum_entry_t **e = malloc((size_t)(s->n + 1) * sizeof *e);
     for (int i = 0; i < s->n; i++) e[i] = &s->e[i];
@@ -160,7 +161,7 @@ int io_summary_write(const io_summary_t *s, const char *path)
     write_object(f, e, s->n, 0);
     fputs("\n}\n", f);
     free(e);
-    return fclose(f) == 0 ? 0 : -1;
+    return atomic_commit(f, tmp, path);
 }
 
 void io_summary_free(io_summary_t *s)

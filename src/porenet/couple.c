@@ -7,7 +7,10 @@
 #include "dem.h"
 #include "porenet.h"
 
-int pn_model_couple_dem(pn_model_t *m, dem_t *d, const double g[3], double dt)
+/* The model keeps its own order of the spheres, that of the particle ids:
+ * the pore volume rates compare the positions of the same sphere at two
+ * steps. */
+void pn_model_gather_dem(pn_model_t *m, const dem_t *d)
 {
     const int n = dem_count(d);
     const double *x = dem_positions(d), *r = dem_radii(d);
@@ -16,14 +19,18 @@ int pn_model_couple_dem(pn_model_t *m, dem_t *d, const double g[3], double dt)
         m->xid = realloc(m->xid, 3 * (size_t)n * sizeof *m->xid);
         m->rid = realloc(m->rid, (size_t)n * sizeof *m->rid);
     }
-    /* the model keeps its own (id) order: the pore volume rates compare the
-     * positions of the same sphere at two steps */
     for (int i = 0; i < n; i++) {
         const long k = id[i];
         for (int a = 0; a < 3; a++) m->xid[3 * k + a] = x[3 * i + a];
         m->rid[k] = r[i];
     }
-    if (pn_model_step(m, n, m->xid, m->rid, dt)) return -1;
+}
+
+void pn_model_forces_to_dem(pn_model_t *m, dem_t *d, const double g[3])
+{
+    const int n = dem_count(d);
+    const double *r = dem_radii(d);
+    const long *id = dem_ids(d);
     double *fe = dem_ext_force(d), *te = dem_ext_torque(d);
     for (int i = 0; i < n; i++) {
         const long k = id[i];
@@ -34,6 +41,13 @@ int pn_model_couple_dem(pn_model_t *m, dem_t *d, const double g[3], double dt)
             te[3 * i + a] = 0;
         }
     }
+}
+
+int pn_model_couple_dem(pn_model_t *m, dem_t *d, const double g[3], double dt)
+{
+    pn_model_gather_dem(m, d);
+    if (pn_model_step(m, dem_count(d), m->xid, m->rid, dt)) return -1;
+    pn_model_forces_to_dem(m, d, g);
     return 0;
 }
 

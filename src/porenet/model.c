@@ -23,6 +23,7 @@ void pn_model_free(pn_model_t *m)
     free(m->fp);
     free(m->fv);
     free(m->x_cont);
+    free(m->x_tri);
     free(m->xid);
     free(m->rid);
     free(m->snap_time);
@@ -32,7 +33,7 @@ void pn_model_free(pn_model_t *m)
     m->nsnap = 0;
     m->sol = NULL;
     m->p = m->vol = m->vol_prev = m->dvdt = m->x_prev = m->f = m->fp = m->fv = NULL;
-    m->x_cont = m->xid = m->rid = NULL;
+    m->x_cont = m->x_tri = m->xid = m->rid = NULL;
     m->built = 0;
 }
 
@@ -65,7 +66,9 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
         m->fv = realloc(m->fv, 3 * (size_t)n * sizeof *m->fv);
         m->x_prev = realloc(m->x_prev, 3 * (size_t)n * sizeof *m->x_prev);
         m->x_cont = realloc(m->x_cont, 3 * (size_t)n * sizeof *m->x_cont);
+        m->x_tri = realloc(m->x_tri, 3 * (size_t)n * sizeof *m->x_tri);
     }
+    memcpy(m->x_tri, x, 3 * (size_t)n * sizeof *x);
     m->n = n;
     m->built = 1;
     m->n_retri++;
