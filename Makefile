@@ -6,6 +6,7 @@
 #   make restitution  restitution sweeps of issue 5 (wall and binary; 1.3 min on 2 cores, measured in session 8);
 #                   RESTITUTION_SET='section.key=value ...' overrides keys in every run,
 #                   RESTITUTION_OUT=dir the output directory (default build/restitution)
+#   make bounce     the bouncing sphere against experiments, lubrication cut-off, oblique bounces (FULL=1: finer)
 #   make fuzz       the long fuzz series of tests/fuzz.py (40 check and 8 run mutants of every case file;
 #                   FUZZ_SEED=N other mutants, FUZZ_ARGS='--checks 200' more); make test runs a quick subset
 #   make bench      benchmarks, results appended to docs/performance.md
@@ -36,7 +37,7 @@ BIN     := $(BUILD)/ibmdem
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 BENCHES := $(patsubst bench/%.c,$(BUILD)/bench/%,$(wildcard bench/bench_*.c))
 
-.PHONY: all test demo validate bench deps clean restitution fuzz
+.PHONY: all test demo validate bench deps clean restitution bounce fuzz
 all: $(BIN) $(TESTS) $(BENCHES)
 
 $(BUILD)/obj/%.o: src/%.c
@@ -94,6 +95,12 @@ RESTITUTION_OUT ?= $(BUILD)/restitution
 restitution: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bash scripts/restitution.sh $(RESTITUTION_OUT) full $(RESTITUTION_SET)
+
+# the bouncing sphere against the experiments of Gondret et al. (2002), the lubrication cut-off and the
+# oblique bounces (part of make validate); FULL=1 adds D/dx = 40 (and 30 at St 152): about 3 hours
+bounce: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) OUT=$(BUILD)/bounce FULL=$(FULL) bash scripts/validate_bounce.sh
 
 # mutated case files through check and a few steps of run, clean outcomes only (part of make validate)
 FUZZ_SEED ?= 17
