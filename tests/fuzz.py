@@ -264,12 +264,21 @@ def limit_memory(limit):
     return f
 
 
+# Open MPI failing to start (MPI_Init aborts before ibmdem's code runs), seen once in a few hundred
+# starts on a loaded machine: the environment's, not the input's; such a start is tried again
+MPI_START = re.compile(r"before MPI_INIT completed|It looks like (opal|orte|MPI)_init failed")
+
+
 def run(cmd, timeout, mem, env):
-    try:
-        p = subprocess.run(cmd, capture_output=True, timeout=timeout, preexec_fn=limit_memory(mem), env=env)
-        return p.returncode, p.stdout.decode("utf-8", "replace"), p.stderr.decode("utf-8", "replace")
-    except subprocess.TimeoutExpired as e:
-        return "timeout", (e.stdout or b"").decode("utf-8", "replace"), (e.stderr or b"").decode("utf-8", "replace")
+    for attempt in range(3):
+        try:
+            p = subprocess.run(cmd, capture_output=True, timeout=timeout, preexec_fn=limit_memory(mem), env=env)
+            rc, out, err = p.returncode, p.stdout.decode("utf-8", "replace"), p.stderr.decode("utf-8", "replace")
+        except subprocess.TimeoutExpired as e:
+            return "timeout", (e.stdout or b"").decode("utf-8", "replace"), (e.stderr or b"").decode("utf-8", "replace")
+        if rc == 0 or not MPI_START.search(err):
+            break
+    return rc, out, err
 
 
 CRASH = re.compile(r"Sanitizer|runtime error:|Segmentation|\*\*\* Process received signal|core dumped|HDF5-DIAG")
@@ -420,6 +429,9 @@ def main():
             if why is None and not a.keep:
                 os.remove(path)
                 shutil.rmtree(outdir, ignore_errors=True)
+            else:
+                with open(os.path.join(work, name + ".err"), "w") as f:
+                    f.write(err)
             return job, rc, why, mu.what, err
 
         results = list(pool.map(one, [j for j in jobs if bases[j[1]] is not None]))
