@@ -3,7 +3,7 @@
 #   make test       install missing Debian packages, build, run the test suite (1 and 2 ranks)
 #   make demo       install, build, run the built-in demo case and plot it
 #   make validate   full-size validation cases (long)
-#   make restitution  restitution sweeps of issue 5 (wall and binary; 1.3 min on 2 cores, measured in session 8);
+#   make restitution  restitution sweeps (wall and binary; about 15 min on 2 cores);
 #                   RESTITUTION_SET='section.key=value ...' overrides keys in every run,
 #                   RESTITUTION_OUT=dir the output directory (default build/restitution)
 #   make bounce     the bouncing sphere against experiments, lubrication cut-off, oblique bounces (FULL=1: finer)
@@ -89,7 +89,7 @@ bench: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bash bench/run.sh
 
-# restitution curves of the bouncing sphere and the binary collision (issue 5): the sweep in
+# restitution curves of the bouncing sphere and the binary collision: the sweep in
 # parallel on the available cores, build/restitution/{restitution,binary}.{csv,png}, target checks
 RESTITUTION_OUT ?= $(BUILD)/restitution
 restitution: deps

@@ -49,7 +49,8 @@ static const cfg_key_t coupling_keys[] = {
      "fluid step; consistent: they act on m_p + C_M rho V_p (Izard eqs. 3.24, 3.26) and the fluid's reaction "
      "C_M rho V_p dU/dt_f to the velocity change they made is removed from the next held force (docs/theory.md §9.1)"},
     {"coupling", "added_mass_coefficient", CFG_DOUBLE, "0.5", 0, 10, NULL,
-     "added_mass = consistent: C_M (1/2, a sphere in unbounded fluid, the seed's value for walls and pairs)"},
+     "added_mass = consistent: C_M (1/2, a sphere in unbounded fluid, the seed's value for walls and pairs; "
+     "0.803, a sphere touching a wall or the symmetry plane of two equal spheres, docs/theory.md §9.1)"},
     {"coupling", "restitution_axis", CFG_VEC3, NULL, -1e300, 1e300, NULL,
      "wall: direction from the particle towards the wall (default: along gravity)"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
