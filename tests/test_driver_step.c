@@ -32,12 +32,12 @@ static int run_with_limit(double lim, const char *name, long *step, char *status
     char dir[256], set[300];
     snprintf(dir, sizeof dir, "/tmp/ibmdem_driver_step_%s_%d", name, mpi_size());
     snprintf(set, sizeof set, "output.dir=%s", dir);
-    char *sets[] = {set, "output.progress=off"};
+    char *sets[] = {set, "output.progress=off", "output.overwrite=true"}; /* the folder of the last make test */
     cfg_t *cfg = cfg_load_string("step.ini",
                                  "[domain]\ngeometry = 2d\nnx = 8\nny = 8\nlength = 1 1 1\n[boundary]\n"
                                  "x_lo = noslip\nx_hi = noslip\ny_lo = noslip\ny_hi = noslip\ny_hi_velocity = 1 0 0\n"
                                  "[fluid]\nnu = 0.01\n[time]\nt_end = 0.1\n",
-                                 2, sets);
+                                 3, sets);
     assert_non_null(cfg);
     sim_t *s = sim_create(cfg, NULL, 0);
     limit = lim;
