@@ -26,11 +26,17 @@ BUILD   ?= build
 OPT     := -O3 -march=native -g
 endif
 CFLAGS  := $(STD) $(OPT) $(WARN) -Iinclude $(HDF5_CFLAGS) $(EXTRA_CFLAGS)
-LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -lgsl -lgslcblas -lqhull_r -lcholmod -lsuitesparseconfig -lm -fopenmp
+LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -lgsl -lgslcblas -lqhull_r -lcholmod -lsuitesparseconfig \
+           -lgmp -lmpfr -lstdc++ -lm -fopenmp
+# C++ (CGAL's regular triangulation, src/porenet/regular_cgal.cpp): interval
+# arithmetic of the exact predicates needs -frounding-math
+CXX     := g++
+CXXFLAGS := -std=c++17 $(OPT) -Wall -Wextra -frounding-math -Iinclude $(EXTRA_CFLAGS)
 TESTLIBS := -lcmocka
 
 SRC     := $(filter-out src/main.c,$(shell find src -name '*.c' | sort))
-OBJ     := $(patsubst src/%.c,$(BUILD)/obj/%.o,$(SRC))
+CXXSRC  := $(shell find src -name '*.cpp' | sort)
+OBJ     := $(patsubst src/%.c,$(BUILD)/obj/%.o,$(SRC)) $(patsubst src/%.cpp,$(BUILD)/obj/%.o,$(CXXSRC))
 DEP     := $(OBJ:.o=.d)
 LIB     := $(BUILD)/libibmdem.a
 BIN     := $(BUILD)/ibmdem
@@ -43,6 +49,10 @@ all: $(BIN) $(TESTS) $(BENCHES)
 $(BUILD)/obj/%.o: src/%.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
+
+$(BUILD)/obj/%.o: src/%.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -MMD -MP -c $< -o $@
 
 # The DEM kernels take square roots of non-negative numbers only: without errno
 # handling the contact loop of src/dem/dem_kernel.inc vectorises (SIMD).  The

@@ -45,6 +45,9 @@ typedef struct {
         double eps_acc, q[6], kappa[3];
         double *p, *vol, *vol_prev, *x_prev, *f, *x_tri;
     } prev;
+    int snapshots;      /* write the network at the run's snapshot times */
+    void (*before_start)(void *ctx); /* called once before the first solve (sim_porenet_before_start) */
+    void *before_ctx;
 } porenet_part_t;
 
 static const char *const pn_cols[] = {"porenet_q_in_max", "porenet_q_out_max", "porenet_p_max", "porenet_pores"};
@@ -152,12 +155,21 @@ static int solve_now(porenet_part_t *pp, double dt)
     return 0;
 }
 
+/* Arithmetic mean diameter of the spheres (κ/d²). */
+static double mean_diameter(const porenet_part_t *pp)
+{
+    double s = 0;
+    for (int i = 0; i < pp->n; i++) s += 2 * pp->r[i];
+    return pp->n ? s / pp->n : NAN;
+}
+
 /* The first solve, once the particles exist (the DEM prepares its packing
  * lazily, at the first step of a new run). */
 static void ensure_started(porenet_part_t *pp)
 {
     if (pp->started) return;
     pp->started = 1;
+    if (pp->before_start) pp->before_start(pp->before_ctx);
     if (pp->with_dem) pp->d = sim_dem_engine(pp->sim);
     if (solve_now(pp, 0.0)) {
         if (!pp->with_dem) cfg_fail(pp->cfg, "porenet", "packing", "%s", pp->m.err);
@@ -175,8 +187,12 @@ static void ensure_started(porenet_part_t *pp)
     if (pp->with_dem)
         msg("porenet: coupled with the DEM, viscous step limit %.4g s (DEM step %.4g s)\n", pn_coupled_dt(&pp->m, pp->d),
             dem_dt(pp->d));
+    const double d = mean_diameter(pp);
     for (int a = 0; a < 3; a++)
-        if (isfinite(pp->kappa[a])) msg("porenet: permeability along %c = %.6e m^2\n", 'x' + a, pp->kappa[a]);
+        if (isfinite(pp->kappa[a]))
+            msg("porenet: permeability along %c = %.6e L^2 (L the length unit of the case: m^2 for lengths in m), "
+                "kappa/d^2 = %.6e (d = %.6g, the mean diameter)\n",
+                'x' + a, pp->kappa[a], pp->kappa[a] / (d * d), d);
 }
 
 static double part_stable_dt(void *ctx)
@@ -291,99 +307,41 @@ static void part_restore_previous(void *ctx)
     pp->failed = 0; /* the DEM part brought back its external forces */
 }
 
-static void part_checkpoint_write(void *ctx, hid_t grp)
-{
-    porenet_part_t *pp = ctx;
-    ensure_started(pp);
-    pn_model_t *m = &pp->m;
-    const long np = m->net.npore, n3 = 3L * m->n;
-    io_h5_attr_long(grp, "spheres", m->n);
-    io_h5_attr_long(grp, "pores", np);
-    io_h5_attr_long(grp, "triangulations", m->n_retri);
-    io_h5_attr_long(grp, "steps", m->n_steps);
-    io_h5_attr_long(grp, "volumes_current", m->vol_current);
-    io_h5_attr_double(grp, "strain_since_triangulation", m->eps_acc);
-    io_h5_attr_string(grp, "layout", "spheres in the order of the particle ids (the DEM's), pores in the order of "
-                                     "the network built from triangulation_positions");
-    io_h5_write_matrix(grp, "triangulation_positions", m->n, 3, m->x_tri);
-    io_h5_write_matrix(grp, "previous_positions", m->n, 3, m->x_prev);
-    io_h5_write_matrix(grp, "force", m->n, 3, m->f);
-    io_h5_write_array(grp, "pressure", np, m->p);
-    io_h5_write_array(grp, "pore_volume", np, m->vol);
-    io_h5_write_array(grp, "pore_volume_previous", np, m->vol_prev);
-    (void)n3;
-    io_h5_attr_long(grp, "snapshots", m->nsnap);
-    if (m->nsnap > 0) {
-        double *c = xcalloc(4 * (size_t)m->nsnap, sizeof *c);
-        for (long i = 0; i < 4L * m->nsnap; i++) c[i] = (double)m->snap_counts[i];
-        io_h5_write_array(grp, "snapshot_times", m->nsnap, m->snap_time);
-        io_h5_write_matrix(grp, "snapshot_counts", m->nsnap, 4, c);
-        free(c);
-    }
-}
-
-static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
-{
-    porenet_part_t *pp = ctx;
-    pn_model_t *m = &pp->m;
-    long n = 0, np = 0, nretri = 0, nsteps = 0, volc = 0, nsnap = 0;
-    double eps = 0;
-    if (io_h5_get_attr_long(grp, "spheres", &n) || io_h5_get_attr_long(grp, "pores", &np) ||
-        io_h5_get_attr_long(grp, "triangulations", &nretri) || io_h5_get_attr_long(grp, "steps", &nsteps) ||
-        io_h5_get_attr_long(grp, "volumes_current", &volc) ||
-        io_h5_get_attr_double(grp, "strain_since_triangulation", &eps) ||
-        io_h5_get_attr_long(grp, "snapshots", &nsnap))
-        die("%s: /porenet lacks the attributes of the model's state", path);
-    if (pp->with_dem) {
-        pp->d = sim_dem_engine(pp->sim); /* the particles come from the checkpoint */
-        if (n != dem_count(pp->d)) die("%s: /porenet holds %ld spheres, the DEM %d", path, n, dem_count(pp->d));
-        m->n = (int)n;
-    } else if (n != pp->n) {
-        die("%s: /porenet holds %ld spheres, porenet.packing %d", path, n, pp->n);
-    }
-    double *x_tri = xcalloc(3 * (size_t)n + 1, sizeof(double)), *x_prev = xcalloc(3 * (size_t)n + 1, sizeof(double));
-    double *f = xcalloc(3 * (size_t)n + 1, sizeof(double)), *p = xcalloc((size_t)np + 1, sizeof(double));
-    double *vol = xcalloc((size_t)np + 1, sizeof(double)), *vol_prev = xcalloc((size_t)np + 1, sizeof(double));
-    if (io_h5_read_array(grp, "triangulation_positions", 3 * n, x_tri) != 3 * n ||
-        io_h5_read_array(grp, "previous_positions", 3 * n, x_prev) != 3 * n ||
-        io_h5_read_array(grp, "force", 3 * n, f) != 3 * n || io_h5_read_array(grp, "pressure", np, p) != np ||
-        io_h5_read_array(grp, "pore_volume", np, vol) != np ||
-        io_h5_read_array(grp, "pore_volume_previous", np, vol_prev) != np)
-        die("%s: /porenet: a dataset of the model's state is missing or has the wrong size", path);
-    if (pp->with_dem) pn_model_gather_dem(m, pp->d); /* the radii in the model's order */
-    set_state(pp, nretri, nsteps, (int)volc, eps, x_tri, p, vol, vol_prev, x_prev, f);
-    if (m->net.npore != np) die("%s: /porenet holds %ld pores, the network rebuilt from it %d", path, np, m->net.npore);
-    if (pp->with_dem) {
-        pn_model_forces_to_dem(m, pp->d, pp->g); /* the forces of the step before the checkpoint */
-        pp->x = m->xid;
-        pp->r = m->rid;
-        pp->n = m->n;
-    }
-    after_solve(pp);
-    pp->started = 1;
-    free(x_tri), free(x_prev), free(f), free(p), free(vol), free(vol_prev);
-    /* the snapshots: the list of the earlier ones, without those the lost continuation wrote */
-    m->nsnap = (int)nsnap;
-    m->snap_time = realloc(m->snap_time, ((size_t)nsnap + 1) * sizeof *m->snap_time);
-    m->snap_counts = realloc(m->snap_counts, 4 * ((size_t)nsnap + 1) * sizeof *m->snap_counts);
-    if (nsnap > 0) {
-        double *c = xcalloc(4 * (size_t)nsnap, sizeof *c);
-        if (io_h5_read_array(grp, "snapshot_times", nsnap, m->snap_time) != nsnap ||
-            io_h5_read_array(grp, "snapshot_counts", 4 * nsnap, c) != 4 * nsnap)
-            die("%s: /porenet: the snapshot list is missing or has the wrong size", path);
-        for (long i = 0; i < 4 * nsnap; i++) m->snap_counts[i] = (long)c[i];
-        free(c);
-    }
-    io_outdir_remove_numbered(&pp->sim->out, "porenet_", ".h5", nsnap);
-    pn_write_index(m, pp->sim->out.dir);
-}
-
 static void part_write_fields(void *ctx, double time, long step)
 {
     (void)step;
     porenet_part_t *pp = ctx;
     ensure_started(pp);
-    pn_write_snapshot(&pp->m, pp->x, pp->sim->out.dir, time);
+    if (pp->snapshots) pn_write_snapshot(&pp->m, pp->x, pp->sim->out.dir, time);
+}
+
+static void part_checkpoint_write(void *ctx, hid_t g)
+{
+    porenet_part_t *pp = ctx;
+    ensure_started(pp);
+    pn_model_state_write(&pp->m, g);
+}
+
+/* The state of the run that wrote the checkpoint (state.c): the
+ * triangulation of its last rebuild, the strain accumulated since, the
+ * previous positions and volumes, the pressures, the forces the DEM holds in
+ * its next step and the snapshot index. */
+static void part_checkpoint_read(void *ctx, hid_t g, const char *path)
+{
+    porenet_part_t *pp = ctx;
+    pp->started = 1;
+    pp->d = sim_dem_engine(pp->sim);
+    pn_model_gather(&pp->m, pp->d);
+    if (pn_model_state_read(&pp->m, g, dem_count(pp->d), pp->m.rid)) die("%s: porenet: %s", path, pp->m.err);
+    if (!pp->m.built) die("%s: porenet: the checkpoint holds no network", path);
+    /* the snapshots the lost continuation wrote, and the index of ours */
+    io_outdir_remove_numbered(&pp->sim->out, "porenet_", ".h5", pp->m.nsnap);
+    pn_write_index(&pp->m, pp->sim->out.dir);
+    pn_model_apply_forces(&pp->m, pp->d, pp->g);
+    pp->n = pp->m.n;
+    pp->x = pp->m.xid;
+    pp->r = pp->m.rid;
+    after_solve(pp);
 }
 
 static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
@@ -399,8 +357,13 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
     io_summary_long(y, KEY("%s.throats", prefix), m->net.nthroat);
     io_summary_long(y, KEY("%s.triangulations", prefix), m->n_retri);
     io_summary_long(y, KEY("%s.coupled_steps", prefix), m->n_steps);
+    const double d = mean_diameter(pp);
+    io_summary_double(y, KEY("%s.mean_diameter", prefix), d);
     for (int a = 0; a < 3; a++)
-        if (isfinite(pp->kappa[a])) io_summary_double(y, KEY("%s.permeability_%c", prefix, 'x' + a), pp->kappa[a]);
+        if (isfinite(pp->kappa[a])) {
+            io_summary_double(y, KEY("%s.permeability_%c", prefix, 'x' + a), pp->kappa[a]);
+            io_summary_double(y, KEY("%s.permeability_over_d2_%c", prefix, 'x' + a), pp->kappa[a] / (d * d));
+        }
     for (int f = 0; f < 6; f++)
         if (!m->dom.periodic[f / 2]) io_summary_double(y, KEY("%s.flux_in.%s", prefix, fn[f]), pp->q[f]);
     double F[6][3], fs[3] = {0, 0, 0};
@@ -446,6 +409,8 @@ void sim_add_porenet(sim_t *s, cfg_t *cfg)
     pp->cfg = cfg;
     pn_model_from_config(cfg, &pp->m);
     pp->with_dem = cfg_has_section(cfg, "particles");
+    const int snaps = cfg_enum(cfg, "porenet", "snapshots");
+    pp->snapshots = snaps == 1 || (snaps == 0 && pp->with_dem);
     if (pp->with_dem) {
         if (cfg_has(cfg, "porenet", "packing"))
             cfg_fail(cfg, "porenet", "packing", "the scene has DEM particles ([particles]): give one or the other");
@@ -481,10 +446,32 @@ void sim_add_porenet(sim_t *s, cfg_t *cfg)
         .keep_previous = part_keep_previous,
         .restore_previous = part_restore_previous,
         .write_fields = part_write_fields,
-        .checkpoint_write = part_checkpoint_write,
-        .checkpoint_read = part_checkpoint_read,
+        /* a fixed packing is solved once: nothing to restart from */
+        .checkpoint_write = pp->with_dem ? part_checkpoint_write : NULL,
+        .checkpoint_read = pp->with_dem ? part_checkpoint_read : NULL,
         .summary = part_summary,
         .destroy = part_destroy,
     };
     sim_add_part(s, &part);
+}
+
+static porenet_part_t *find_part(sim_t *s)
+{
+    for (int p = 0; p < s->npart; p++)
+        if (!strcmp(s->part[p].name, "porenet")) return s->part[p].ctx;
+    return NULL;
+}
+
+pn_model_t *sim_porenet_model(sim_t *s)
+{
+    porenet_part_t *pp = find_part(s);
+    return pp ? &pp->m : NULL;
+}
+
+void sim_porenet_before_start(sim_t *s, void (*fn)(void *ctx), void *ctx)
+{
+    porenet_part_t *pp = find_part(s);
+    if (!pp) die("sim_porenet_before_start: the scene has no pore network");
+    pp->before_start = fn;
+    pp->before_ctx = ctx;
 }

@@ -7,10 +7,7 @@
 #include "dem.h"
 #include "porenet.h"
 
-/* The model keeps its own order of the spheres, that of the particle ids:
- * the pore volume rates compare the positions of the same sphere at two
- * steps. */
-void pn_model_gather_dem(pn_model_t *m, const dem_t *d)
+void pn_model_gather(pn_model_t *m, const dem_t *d)
 {
     const int n = dem_count(d);
     const double *x = dem_positions(d), *r = dem_radii(d);
@@ -26,7 +23,15 @@ void pn_model_gather_dem(pn_model_t *m, const dem_t *d)
     }
 }
 
-void pn_model_forces_to_dem(pn_model_t *m, dem_t *d, const double g[3])
+int pn_model_couple_dem(pn_model_t *m, dem_t *d, const double g[3], double dt)
+{
+    pn_model_gather(m, d);
+    if (pn_model_step(m, dem_count(d), m->xid, m->rid, dt)) return -1;
+    pn_model_apply_forces(m, d, g);
+    return 0;
+}
+
+void pn_model_apply_forces(const pn_model_t *m, dem_t *d, const double g[3])
 {
     const int n = dem_count(d);
     const double *r = dem_radii(d);
@@ -41,14 +46,6 @@ void pn_model_forces_to_dem(pn_model_t *m, dem_t *d, const double g[3])
             te[3 * i + a] = 0;
         }
     }
-}
-
-int pn_model_couple_dem(pn_model_t *m, dem_t *d, const double g[3], double dt)
-{
-    pn_model_gather_dem(m, d);
-    if (pn_model_step(m, dem_count(d), m->xid, m->rid, dt)) return -1;
-    pn_model_forces_to_dem(m, d, g);
-    return 0;
 }
 
 double pn_coupled_dt(const pn_model_t *m, const dem_t *d)
