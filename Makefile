@@ -6,6 +6,8 @@
 #   make restitution  restitution sweeps of issue 5 (wall and binary; 1.3 min on 2 cores, measured in session 8);
 #                   RESTITUTION_SET='section.key=value ...' overrides keys in every run,
 #                   RESTITUTION_OUT=dir the output directory (default build/restitution)
+#   make viscous_stability  the stability map of the coupled step at large viscous numbers
+#                   (build/viscous_stability/map.md; ~25 min on 2 cores)
 #   make bench      benchmarks, results appended to docs/performance.md
 #   make deps       install missing Debian packages (apt-get)
 #   SANITIZE=1      build with AddressSanitizer + UBSan into build-san/
@@ -34,7 +36,7 @@ BIN     := $(BUILD)/ibmdem
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 BENCHES := $(patsubst bench/%.c,$(BUILD)/bench/%,$(wildcard bench/bench_*.c))
 
-.PHONY: all test demo validate bench deps clean restitution
+.PHONY: all test demo validate bench deps clean restitution viscous_stability
 all: $(BIN) $(TESTS) $(BENCHES)
 
 $(BUILD)/obj/%.o: src/%.c
@@ -92,6 +94,12 @@ RESTITUTION_OUT ?= $(BUILD)/restitution
 restitution: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bash scripts/restitution.sh $(RESTITUTION_OUT) full $(RESTITUTION_SET)
+
+# the stability map of the coupled step at large viscous numbers (docs/theory.md §4.6, §9.1):
+# build/viscous_stability/map.md
+viscous_stability: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bash scripts/viscous_stability.sh $(BUILD)/viscous_stability
 
 clean:
 	rm -rf build build-san
