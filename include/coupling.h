@@ -102,6 +102,22 @@ dem_status_t coupling_drag_advance(coupling_drag_t *dr, const ibm_t *ibm, dem_t 
  * the solid fraction rebuilt (collective). */
 void coupling_motion_to_ibm(const dem_t *d, ibm_t *ibm);
 
+/* ---- dimensionless numbers (numbers.c) ----------------------------------------- */
+
+typedef struct {
+    double D, ratio;     /* diameter, ρ_p/ρ */
+    double Ga;           /* Galileo number √((ρ_p/ρ − 1) g D³)/ν (0 when the particle does not sink) */
+    double V_T, Re_T;    /* Schiller–Naumann terminal velocity and its Reynolds number */
+    double St_T;         /* (ρ_p + ρ/2) V_T D/(9μ), the Stokes number of a bounce at V_T (Izard eq. 3.19) */
+    double D_over_h;     /* resolution (0: no grid) */
+    double tc_g, tc_VT;  /* contact time t_c √(g/D) and t_c V_T/D */
+} coupling_numbers_t;
+
+/* The numbers of a particle of diameter D and density rho_p in a fluid (rho_f, mu) under gravity
+ * |g|, grid spacing h (0: none) and contact time tc. */
+void coupling_numbers(double D, double rho_p, double rho_f, double mu, double g, double h, double tc,
+                      coupling_numbers_t *n);
+
 /* ---- restitution (restitution.c) ---------------------------------------------- */
 
 typedef enum { RESTITUTION_OFF = 0, RESTITUTION_WALL = 1, RESTITUTION_PAIR = 2 } restitution_mode_t;
@@ -121,6 +137,16 @@ typedef struct {
     double VR_release;   /* rebound speed when the contact ends (sub-step) */
     double t_contact, t_release;
     double lub_impulse;  /* lubrication impulse on particle 0 against its approach direction, last fluid step */
+    /* the rebound as an experiment records it (the trajectory of the gap, sampled at every sub-step) */
+    double fit_window;   /* [coupling] fit_window; 0: 0.2 D/V_T */
+    double window;       /* the window used (set at the contact) */
+    long ntraj, captraj; /* samples (t, gap) of the approach (gap < 0.3 D) and of the rebound window */
+    double *traj;
+    double V_in, V_out;  /* speeds fitted over the window before the contact and after the release */
+    double apex, t_apex; /* largest gap after the release (wall), and when */
+    /* oblique impacts (wall): the velocity of the contact point, v + ω × R n (n towards the wall), in the
+     * plane of the wall, at the sub-step before the contact and when it ends, and the centre's */
+    double cp_last[3], cp_in[3], cp_out[3], vt_out[3], vn_out;
 } restitution_t;
 
 /* axis: wall mode: unit vector from the particle towards the wall. */
@@ -136,6 +162,19 @@ double restitution_approach_speed(const restitution_t *r, dem_t *d, int full_ste
  * (wall, eq. 3.19), or ε_B and St_B = ρ_p U D/(9μ), Re = ρ U D/μ (pair,
  * eq. 3.34–3.35, no added mass). */
 double restitution_epsilon(const restitution_t *r);
+/* Oblique impacts against a wall (Joseph & Hunt 2004, at the contact point): Ψ_in = |u_t,in|/u_n,in,
+ * Ψ_out = u_t,out·t̂_in/u_n,in (t̂_in the direction of u_t,in), β = −Ψ_out/Ψ_in, the effective friction
+ * μ_f = 2(1 + β)Ψ_in/(7(1 + e)), and the rebound angle of the centre's velocity from the wall normal
+ * (degrees); u_t,in and u_t,out are the contact point's tangential velocities at the sub-steps before
+ * and after the contact, u_n,in = V_in and e = V_out/V_in the trajectory fits (without them: the
+ * sub-step speeds V_C_onset and V_release/V_C_onset); 0 when the impact is normal or not measured. */
+void restitution_oblique(const restitution_t *r, double *psi_in, double *psi_out, double *beta, double *mu_f,
+                         double *angle_out);
+/* The experiment-like ε = V_out/V_in of the trajectory fits (0 before they are made). */
+double restitution_epsilon_fit(const restitution_t *r);
+void restitution_free(restitution_t *r);
+/* The rebound's fits are made (the window after the release has passed, or a second contact came first). */
+int restitution_measured(const restitution_t *r);
 double restitution_stokes(const restitution_t *r);
 double restitution_reynolds(const restitution_t *r);
 

@@ -127,6 +127,12 @@ static inline int dem_in_contact(const dem_t *d, int i)
 void dem_lubrication_register_keys(void);
 /* Lubrication force on each particle in the last step (impulse / dt), 3n. */
 const double *dem_lubrication_forces(const dem_t *d);
+/* The grid spacing of the resolved fluid (model = correction adds only what it
+ * does not resolve, below a cut-off in grid cells); 0: no resolved fluid. */
+void dem_lubrication_set_grid(dem_t *d, double h);
+/* Largest damping rate (1/s) of the explicit tangential lubrication on a particle of radius R and mass m
+ * (0 without it): the DEM step must stay well below its inverse. */
+double dem_lubrication_tangential_rate(const dem_t *d, double R, double m);
 /* Time until the first particle–particle or particle–wall contact (0: a
  * contact exists; INFINITY: nothing approaches).  Without lubrication at the
  * current velocities; lubricated pairs along their lubricated approach with
@@ -155,6 +161,8 @@ int dem_wall_active(const dem_t *d, int w);
 const char *dem_wall_name(const dem_t *d, int w);
 /* Index of the wall with this name (x_lo ... z_hi, wall1 ...), -1: none. */
 int dem_wall_find(const dem_t *d, const char *name);
+/* Smallest gap between particle i and the active walls (INFINITY: none). */
+double dem_wall_gap_min(const dem_t *d, int i);
 /* A point of wall w (it moves with the wall). */
 void dem_wall_position(const dem_t *d, int w, double p[3]);
 /* Move wall w (between steps) so that its plane passes through p. */

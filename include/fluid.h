@@ -116,6 +116,8 @@ void fluid_register_keys(void);
 /* Read [fluid] and [poisson] and check them against the grid; stops with
  * file:line: key: reason.  ([time] and [output] belong to the run driver.) */
 void fluid_params_from_config(cfg_t *cfg, const grid_t *g, fluid_params_t *prm);
+/* The kinematic viscosity of [fluid]: nu, or mu/rho. */
+double fluid_nu_from_config(cfg_t *cfg);
 fluid_t *fluid_create(grid_t *g, const fluid_params_t *prm);
 /* Set the initial condition named in [fluid] init (stops on a bad value):
  * rest, taylor_green, abc or laminar (see docs/user-guide.md).  The field is

@@ -85,6 +85,8 @@ grid_t *grid_create(geom_t geom, const int n[3], const double L[3], const double
 grid_t *grid_create_uniform_arithmetic(geom_t geom, const int n[3], const double L[3], const double x0[3], const bc_t *bc,
                                        int nu, double lu, MPI_Comm comm);
 void grid_free(grid_t *g);
+/* The smallest cell size of the grid, over every direction. */
+double grid_min_spacing(const grid_t *g);
 
 double *field_alloc(const grid_t *g);
 void field_copy(const grid_t *g, double *dst, const double *src);

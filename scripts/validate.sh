@@ -152,6 +152,11 @@ IBM_FULL3D=1 IBM_TESTS=test_settling_3d $MPIRUN -np 2 "$BUILD/tests/test_ibm_set
 section "coupling: bouncing sphere (Izard Fig. 3.3), phases, no lubrication, D/dx = 8..40, 3-D"
 BUILD=$BUILD OUT=$OUT bash scripts/validate_coupling.sh || fail "coupling bouncing sphere"
 
+# --- coupling: the bouncing sphere against experiments (Gondret et al. 2002, St 27 and 152), the
+# lubrication correction's cut-off, oblique bounces (scripts/validate_bounce.sh; ~20 min on 2 cores)
+section "coupling: bouncing sphere against experiments, lubrication cut-off, oblique bounces"
+BUILD=$BUILD OUT=$OUT bash scripts/validate_bounce.sh || fail "coupling bounce against experiments"
+
 # --- permeability: the same packing of 200 spheres through the resolved solver (D/dx = 8.6,
 # 12.9, 17.2) and the pore network, and the simple cubic array against Zick & Homsy (1982)
 # at D/dx = 8, 12, 16 (scripts/permeability_crosscheck.sh; table in

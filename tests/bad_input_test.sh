@@ -79,7 +79,7 @@ check "syntax error" 2 "^$f:13: syntax error" -- $BIN check "$f"
 f=$T/ok.ini
 check "bad --set (no section.key=value)" 2 "^--set nu: expected section.key=value$" -- $BIN check "$f" --set nu
 check "bad --set (wrong type)" 2 "^--set fluid.nu: 'abc' is not a real number$" -- $BIN check "$f" --set fluid.nu=abc
-check "bad --set (unknown key)" 2 "^--set fluid.mu: unknown key$" -- $BIN check "$f" --set fluid.mu=1
+check "bad --set (unknown key)" 2 "^--set fluid.eta: unknown key$" -- $BIN check "$f" --set fluid.eta=1
 
 check "unreadable file" 2 "^$T/nope.ini: cannot open: No such file or directory$" -- $BIN check "$T/nope.ini"
 cp "$f" "$T/noperm.ini"; chmod 000 "$T/noperm.ini"

@@ -504,6 +504,243 @@ static void test_time_to_contact(void **state)
     }
 }
 
+/* ---- model = correction (only what the grid does not resolve) ---------------------------- */
+
+/* A DEM with lubrication model = correction (cut-offs in cells of h) and extra [lubrication] lines. */
+static dem_t *make_correction_in(double L, int wall, double eta, double cutoff, double tcutoff, int tangential, double h,
+                                 int nc, double gz, const char *lub_keys)
+{
+    char lines[512];
+    snprintf(lines, sizeof lines, "cutoff = %.17g\ntangential_cutoff = %.17g\ntangential = %s\n%s", cutoff, tcutoff,
+             tangential ? "true" : "false", lub_keys);
+    char text[2048];
+    snprintf(text, sizeof text,
+             "[domain]\nlength = %g %g %g\n[boundary]\nz_lo = noslip\nz_hi = noslip\n"
+             "[walls]\nfaces = %s\n[contact]\nrestitution = 0.9\ncontact_time = %g\nfriction = 0.3\n"
+             "[lubrication]\nmodel = correction\nroughness = %.17g\nviscosity = %.17g\n%s"
+             "[dem]\ngravity = 0 0 %.17g\nsteps_per_contact = %d\n",
+             L, L, L, wall ? "z_lo" : "none", TC, eta / R, MU, lines, gz, nc);
+    cfg_t *cfg = cfg_load_string("test.ini", text, 0, NULL);
+    assert_non_null(cfg);
+    dem_t *d = dem_create_from_config(cfg, MPI_COMM_WORLD);
+    dem_lubrication_set_grid(d, h);
+    return d;
+}
+
+static dem_t *make_correction(int wall, double eta, double cutoff, double tcutoff, int tangential, double h, int nc,
+                              double gz, const char *lub_keys)
+{
+    return make_correction_in(0.1, wall, eta, cutoff, tcutoff, tangential, h, nc, gz, lub_keys);
+}
+
+/* The normal part of the correction is Brenner's force less its value at cutoff × h, i.e. brenner
+ * with range = cutoff h and subtract_resolved; without a grid it is brenner up to range × R.  The
+ * same bounce (St 40 against a wall) must be bit-identical. */
+static void test_correction_normal(void **state)
+{
+    (void)state;
+    const double eta = 1e-4 * R, h = 0.1 * R, cutoff = 1.1;
+    const double m = RHO * 4.0 / 3.0 * M_PI * R * R * R, k = 6 * M_PI * MU * R * R, u0 = 40.0 * k / m;
+    for (int grid = 0; grid < 2; grid++) {
+        dem_t *a = make_correction(1, eta, cutoff, 1.0, 0, grid ? h : 0.0, 50, 0.0, "range = 0.5\n");
+        dem_t *b = grid ? make_with(1, eta, cutoff * h, 1, MU, 50, 0.0, 0.9, "", "", "")
+                        : make_with(1, eta, 0.5 * R, 0, MU, 50, 0.0, 0.9, "", "", "");
+        const double x[3] = {0.05, 0.05, R + 0.6 * R}, v[3] = {0, 0, -u0};
+        dem_add_particle(a, x, v, R, RHO, 0);
+        dem_add_particle(b, x, v, R, RHO, 0);
+        long differ = 0, steps = 0;
+        double vmin = 0;
+        for (; steps < 20000; steps++) {
+            assert_int_equal(dem_step(a), DEM_OK);
+            assert_int_equal(dem_step(b), DEM_OK);
+            differ += dem_positions(a)[2] != dem_positions(b)[2] || dem_velocities(a)[2] != dem_velocities(b)[2];
+            vmin = fmin(vmin, dem_velocities(a)[2]);
+            if (dem_positions(a)[2] > 1.7 * R && dem_velocities(a)[2] > 0) break;
+        }
+        printf("correction %s a grid: %ld of %ld steps differ from brenner %s\n", grid ? "with" : "without", differ,
+               steps, grid ? "(range = cutoff h, subtract_resolved)" : "(range 0.5 R)");
+        assert_int_equal(differ, 0);
+        assert_true(dem_velocities(a)[2] > 0); /* it bounced */
+        dem_free(a);
+        dem_free(b);
+    }
+}
+
+/* Tangential terms against a wall (Goldman, Cox & Brenner 1967): a sphere at a fixed gap δ
+ * (no normal motion, no gravity) sliding at u along x and spinning at ω about y obeys, with
+ * w = Rω, ℓ = ln((δ_t + η)/(δ + η)) and c = πμRℓ/m,
+ *   du/dt = c (−16/5 u + 4/5 w),   dw/dt = c (2 u − 8 w)
+ * (F = −6πμRℓ[8/15 u_t + 2/15 R ω × n], T = −8πμR²ℓ[1/10 n × u_t + 2/5 R ω_t], n towards the
+ * wall, I = 2/5 m R²).  The DEM applies the terms explicitly: first order in its step. */
+static void test_tangential_wall_exact(void **state)
+{
+    (void)state;
+    const double eta = 1e-4 * R, h = 0.1 * R, delta = 0.03 * R, tcut = 1.1;
+    const double m = RHO * 4.0 / 3.0 * M_PI * R * R * R;
+    const double ell = log((tcut * h + eta) / (delta + eta)), c = M_PI * MU * R * ell / m;
+    const double T = 0.3 / c; /* about one decay time of the slow mode (rate 2.9 c) */
+    /* exact: x(T) = exp(A T) x0 with A = c [[-16/5, 4/5], [2, -8]], by its eigenvectors */
+    const double a11 = -3.2 * c, a12 = 0.8 * c, a21 = 2.0 * c, a22 = -8.0 * c;
+    const double tr = a11 + a22, det = a11 * a22 - a12 * a21, disc = sqrt(tr * tr / 4 - det);
+    const double l1 = tr / 2 + disc, l2 = tr / 2 - disc;
+    const double u0 = 1e-3, w0 = -0.5e-3; /* spinning against rolling */
+    /* x(t) = e^{l1 t} P1 x0 + e^{l2 t} P2 x0, P1 = (A − l2 I)/(l1 − l2), P2 = (l1 I − A)/(l1 − l2) */
+    const double e1 = exp(l1 * T), e2 = exp(l2 * T), dl = l1 - l2;
+    const double uex = (e1 * ((a11 - l2) * u0 + a12 * w0) + e2 * ((l1 - a11) * u0 - a12 * w0)) / dl;
+    const double wex = (e1 * (a21 * u0 + (a22 - l2) * w0) + e2 * (-a21 * u0 + (l1 - a22) * w0)) / dl;
+    double err[2];
+    for (int q = 0; q < 2; q++) {
+        const int nc = q ? 100 : 50;
+        dem_t *d = make_correction(1, eta, 1.1, tcut, 1, h, nc, 0.0, "");
+        const double x[3] = {0.05, 0.05, R + delta}, v[3] = {u0, 0, 0};
+        dem_add_particle(d, x, v, R, RHO, 0);
+        d->w[1] = w0 / R;
+        const double dt = TC / nc;
+        const long n = lround(T / dt);
+        for (long s = 0; s < n; s++) assert_int_equal(dem_step(d), DEM_OK);
+        dem_sync_velocities(d);
+        const double u = dem_velocities(d)[0], w = R * d->w[1], t = n * dt;
+        /* exact at the DEM's end time t (n dt, within dt/2 of T): re-evaluate */
+        const double f1 = exp(l1 * t), f2 = exp(l2 * t);
+        const double ue = (f1 * ((a11 - l2) * u0 + a12 * w0) + f2 * ((l1 - a11) * u0 - a12 * w0)) / dl;
+        const double we = (f1 * (a21 * u0 + (a22 - l2) * w0) + f2 * (-a21 * u0 + (l1 - a22) * w0)) / dl;
+        err[q] = fmax(fabs(u - ue), fabs(w - we)) / u0;
+        printf("tangential, wall, t_c/dt = %d, %ld steps: u %.8e (exact %.8e), R omega %.8e (exact %.8e), error %.2e; "
+               "gap drift %.1e R\n",
+               nc, n, u, ue, w, we, err[q], (dem_positions(d)[2] - R - delta) / R);
+        assert_true(fabs(dem_positions(d)[2] - R - delta) < 1e-12 * R);
+        dem_free(d);
+    }
+    (void)uex, (void)wex;
+    const double order = log2(err[0] / err[1]);
+    printf("tangential, wall: order %.3f\n", order);
+    /* explicit impulses: first order; the error at t_c/dt = 100 is 2e-6 of u0 (measured) */
+    assert_true(order > 0.9 && order < 1.1);
+    assert_true(err[1] < 1e-5);
+}
+
+/* Tangential terms of a pair: momentum conserved to round-off, energy dissipated for random
+ * motions (the resistance is symmetric and positive), angular momentum about a common point
+ * conserved for equal spheres (to O(δ/R): the lever arm is R_i + R_j + δ), and a sphere against a
+ * very large one (κ = 10⁴, held fixed) acts as against a wall. */
+static void test_tangential_pair_properties(void **state)
+{
+    (void)state;
+    const double eta = 1e-4 * R, h = 0.1 * R, delta = 0.02 * R;
+    unsigned long long seed = 12345;
+#define RND() ((seed = seed * 6364136223846793005ULL + 1442695040888963407ULL), ((double)(seed >> 11) / 9007199254740992.0) - 0.5)
+    double worst_p = 0, worst_L = 0, max_dE = -INFINITY;
+    for (int trial = 0; trial < 40; trial++) {
+        const double kap = trial % 2 ? 1.0 : 2.5, Rj = kap * R;
+        dem_t *d = make_correction(0, eta, 1.1, 1.1, 1, h, 50, 0.0, "");
+        double n[3] = {RND(), RND(), RND()};
+        const double nn = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int a = 0; a < 3; a++) n[a] /= nn;
+        const double xi[3] = {0.05, 0.05, 0.05};
+        double xj[3], vi[3], vj[3];
+        for (int a = 0; a < 3; a++) {
+            xj[a] = xi[a] + (R + Rj + delta) * n[a];
+            vi[a] = 1e-3 * RND();
+            vj[a] = 1e-3 * RND();
+        }
+        /* no relative normal motion: only the tangential terms act */
+        double un = 0;
+        for (int a = 0; a < 3; a++) un += (vj[a] - vi[a]) * n[a];
+        for (int a = 0; a < 3; a++) vj[a] -= un * n[a];
+        dem_add_particle(d, xi, vi, R, RHO, 0);
+        dem_add_particle(d, xj, vj, Rj, RHO, 0);
+        for (int p = 0; p < 2; p++)
+            for (int a = 0; a < 3; a++) d->w[3 * p + a] = 1e-3 / R * RND();
+        assert_int_equal(dem_step(d), DEM_OK); /* lists; then one measured step */
+        dem_sync_velocities(d);
+        double P0[3] = {0}, L0[3] = {0}, E0 = 0;
+        for (int p = 0; p < 2; p++) {
+            const double mp = 1.0 / d->invm[p], Ip = 1.0 / d->invI[p], *x = d->x + 3 * p, *v = d->v + 3 * p,
+                         *w = d->w + 3 * p;
+            for (int a = 0; a < 3; a++) {
+                P0[a] += mp * v[a];
+                L0[a] += Ip * w[a] + mp * (x[(a + 1) % 3] * v[(a + 2) % 3] - x[(a + 2) % 3] * v[(a + 1) % 3]);
+                E0 += 0.5 * (mp * v[a] * v[a] + Ip * w[a] * w[a]);
+            }
+        }
+        double S0[3] = {0};
+        for (int p = 0; p < 2; p++)
+            for (int a = 0; a < 3; a++) S0[a] += d->w[3 * p + a] / d->invI[p];
+        assert_int_equal(dem_step(d), DEM_OK);
+        dem_sync_velocities(d);
+        double P1[3] = {0}, L1[3] = {0}, S1[3] = {0}, E1 = 0, pscale = 0;
+        for (int p = 0; p < 2; p++) {
+            const double mp = 1.0 / d->invm[p], Ip = 1.0 / d->invI[p], *x = d->x + 3 * p, *v = d->v + 3 * p,
+                         *w = d->w + 3 * p;
+            for (int a = 0; a < 3; a++) {
+                P1[a] += mp * v[a];
+                L1[a] += Ip * w[a] + mp * (x[(a + 1) % 3] * v[(a + 2) % 3] - x[(a + 2) % 3] * v[(a + 1) % 3]);
+                S1[a] += Ip * w[a];
+                E1 += 0.5 * (mp * v[a] * v[a] + Ip * w[a] * w[a]);
+            }
+            pscale += mp * 1e-3;
+        }
+        /* momentum relative to the particles' own; angular momentum relative to the change of the
+         * spins the torques make over the step */
+        double dP = 0, dL = 0, dS = 0;
+        for (int a = 0; a < 3; a++) {
+            dP = fmax(dP, fabs(P1[a] - P0[a]) / pscale);
+            dL = fmax(dL, fabs(L1[a] - L0[a]));
+            dS = fmax(dS, fabs(S1[a] - S0[a]));
+        }
+        dL /= dS;
+        worst_p = fmax(worst_p, dP);
+        if (kap == 1.0) worst_L = fmax(worst_L, dL);
+        max_dE = fmax(max_dE, (E1 - E0) / E0);
+        dem_free(d);
+    }
+#undef RND
+    printf("tangential, pair, 40 random motions: momentum change %.1e, angular momentum change (equal spheres) %.1e, "
+           "largest relative energy change %.2e (must be < 0)\n",
+           worst_p, worst_L, max_dE);
+    assert_true(worst_p < 1e-14);
+    assert_true(max_dE < 0);
+    /* the leading terms balance the torques about a common point for equal spheres with the lever
+     * arm 2R; the arm is 2R + δ: an imbalance of order δ/(2R) = 1 % of the spin change */
+    assert_true(worst_L < 0.02);
+
+    /* κ = 10⁴ (the large sphere fixed) against the wall formula */
+    double dv[2][6];
+    for (int wall = 0; wall < 2; wall++) {
+        const double big = 1e4 * R, L = 50 * big;
+        dem_t *d = make_correction_in(L, wall, eta, 1.1, 1.1, 1, h, 50, 0.0, "");
+        const double zi = wall ? R + delta : 0.5 * L + big + R + delta;
+        const double xi[3] = {0.5 * L, 0.5 * L, zi}, vi[3] = {2e-3, -1e-3, 0};
+        dem_add_particle(d, xi, vi, R, RHO, 0);
+        if (!wall) {
+            const double xb[3] = {0.5 * L, 0.5 * L, 0.5 * L}, zero[3] = {0, 0, 0};
+            dem_add_particle(d, xb, zero, big, RHO, 1);
+        }
+        const int i = dem_ids(d)[0] == 0 ? 0 : 1;
+        d->w[3 * i] = 1.5, d->w[3 * i + 1] = -0.7, d->w[3 * i + 2] = 0.3;
+        assert_int_equal(dem_step(d), DEM_OK);
+        dem_sync_velocities(d);
+        const double v0[3] = {d->v[3 * i], d->v[3 * i + 1], d->v[3 * i + 2]};
+        const double w0[3] = {d->w[3 * i], d->w[3 * i + 1], d->w[3 * i + 2]};
+        assert_int_equal(dem_step(d), DEM_OK);
+        dem_sync_velocities(d);
+        for (int a = 0; a < 3; a++) {
+            dv[wall][a] = d->v[3 * i + a] - v0[a];
+            dv[wall][3 + a] = R * (d->w[3 * i + a] - w0[a]);
+        }
+        dem_free(d);
+    }
+    double diff = 0, scale = 0;
+    for (int a = 0; a < 6; a++) {
+        diff = fmax(diff, fabs(dv[0][a] - dv[1][a]));
+        scale = fmax(scale, fabs(dv[1][a]));
+    }
+    printf("tangential, sphere against a sphere 1e4 times larger vs a wall: largest difference %.2e of the change\n",
+           diff / scale);
+    /* the pair coefficients approach the wall's as 1/κ */
+    assert_true(diff < 1e-3 * scale);
+}
+
 int main(int argc, char **argv)
 {
     test_mpi_init(&argc, &argv);
@@ -515,6 +752,9 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_overlap_restitution),
         cmocka_unit_test(test_overlap_force_at_contact),
         cmocka_unit_test(test_time_to_contact),
+        cmocka_unit_test(test_correction_normal),
+        cmocka_unit_test(test_tangential_wall_exact),
+        cmocka_unit_test(test_tangential_pair_properties),
     };
     TEST_MPI_RUN("dem_lubrication", tests);
 }

@@ -29,10 +29,17 @@ static const cfg_key_t coupling_keys[] = {
     {"coupling", "stop_after_rebound", CFG_BOOL, "false", 1, 0, NULL,
      "restitution: stop the run once the bounce is measured (the particle moves towards the wall again, touches "
      "it a second time, rests on it, or stopped before touching it)"},
+    {"coupling", "fit_window", CFG_DOUBLE, "0", 0, 1e300, NULL,
+     "restitution: the window (time) of the trajectory fits before the contact and after the release (the impact "
+     "and rebound speeds as an experiment measures them, epsilon_fit); 0: 0.2 D/V_T"},
     {"coupling", "align_contacts", CFG_BOOL, "true", 1, 0, NULL,
      "end a fluid step t_c/8 before a contact is predicted to start (along the lubricated approach; steps not "
      "shorter than t_c/8, no sliver of a step before a contact), so that collisions start at the beginning of a "
      "fluid step"},
+    {"coupling", "align_release", CFG_BOOL, "true", 1, 0, NULL,
+     "with align_contacts: the fluid step that holds a collision ends t_c/8 after its predicted end (when that is "
+     "shorter than the step the fluid allows), so that the hydrodynamic force held over the collision acts for "
+     "t_c + t_c/4 whatever the fluid step, and the fluid reacts to the rebound from the next step on"},
     {"coupling", "freeze_collisions", CFG_DOUBLE, "2", 0, 1e6, NULL,
      "hold a particle's hydrodynamic force at its value before a contact for up to this many contact times "
      "of contact, the fluid's force meanwhile applied after it (the seed's fluid frozen during collisions; "
@@ -68,7 +75,9 @@ typedef struct {
     dem_status_t status;
     int stop_after;      /* [coupling] stop_after_rebound */
     int align;           /* [coupling] align_contacts */
+    int align_release;   /* [coupling] align_release */
     double freeze;       /* [coupling] freeze_collisions (contact times) */
+    coupling_numbers_t num; /* of particle 0 (a bounce) or of the mean particle; num.D = 0: none */
     coupling_freeze_t fz;
     coupling_added_mass_t am; /* [coupling] added_mass = consistent (am.n > 0) */
     coupling_drag_t drag;     /* [coupling] implicit_drag > 0 (drag.n > 0) */
@@ -98,6 +107,33 @@ static void tracked_particle(coupling_part_t *cp)
     cp->rest.e_dry = dem_dry_restitution(cp->d);
 }
 
+/* The dimensionless numbers of the scene (numbers.c): of particle 0 when a bounce is measured,
+ * otherwise of the mean particle; printed once. */
+static void scene_numbers(coupling_part_t *cp)
+{
+    const int n = dem_count(cp->d);
+    if (!cp->ibm || n == 0 || !(cp->rest.mu > 0)) return;
+    double D = 0, rho_p = 0;
+    if (cp->rest.D > 0) {
+        D = cp->rest.D;
+        rho_p = cp->rest.rho_p;
+    } else {
+        for (int i = 0; i < n; i++) {
+            D += 2 * dem_radii(cp->d)[i] / n;
+            rho_p += dem_density(cp->d, i) / n;
+        }
+    }
+    const double g = sqrt(cp->gravity[0] * cp->gravity[0] + cp->gravity[1] * cp->gravity[1] +
+                          cp->gravity[2] * cp->gravity[2]);
+    coupling_numbers(D, rho_p, cp->rho_f, cp->rest.mu, g, grid_min_spacing(cp->sim->fluid->g), dem_contact_time(cp->d),
+                     &cp->num);
+    const coupling_numbers_t *q = &cp->num;
+    msg("coupling: %s D = %.4g, rho_p/rho = %.4g, Ga = %.4g; Schiller-Naumann V_T = %.4g, Re_T = %.4g, "
+        "St_T = (rho_p + rho/2) V_T D/(9 mu) = %.4g; D/dx = %.3g, t_c sqrt(g/D) = %.3g, t_c V_T/D = %.3g\n",
+        cp->rest.D > 0 ? "particle 0:" : "mean particle:", q->D, q->ratio, q->Ga, q->V_T, q->Re_T, q->St_T, q->D_over_h,
+        q->tc_g, q->tc_VT);
+}
+
 /* The DEM engine (prepared), the tracked particle, gravity, the freeze's
  * hold time and the sub-step observer: at the first use, or after a restart. */
 static void attach(coupling_part_t *cp)
@@ -109,6 +145,7 @@ static void attach(coupling_part_t *cp)
     if (cp->am.n) coupling_added_mass_apply(&cp->am, cp->d, cp->rho_f);
     if (cp->rest.mode != RESTITUTION_OFF) dem_set_step_observer(cp->d, observe, cp);
     if (cp->ibm) memcpy(cp->ibm->prm.gravity, cp->gravity, sizeof cp->gravity);
+    scene_numbers(cp);
 }
 
 /* Once, before the first step of a new run: attach, and the spheres at the
@@ -134,17 +171,28 @@ static void setup(coupling_part_t *cp)
  * noise: the distance is split into two equal steps instead.  The aim is
  * t_c/8 early because the prediction holds the last hydrodynamic force, which
  * grows as the gap closes (the film the grid resolves): it is late by a few
- * sub-steps.  Only the step's own state enters (no previous step): a restart
+ * sub-steps.  With align_release, the step that holds the collision (its
+ * start within t_c/4) ends t_c/8 after the predicted end of the collision,
+ * t_c after its start (a collision of the linear law lasts t_c): the force
+ * held over the collision — that of the approach, pushing the particle away
+ * from the wall — then acts over t_c + t_c/4 however long the fluid step, and
+ * the fluid's reaction to the rebound starts at a fixed time after the
+ * release.  Only the step's own state enters (no previous step): a restart
  * takes the same steps. */
 static double part_align_dt(void *ctx, double T)
 {
     coupling_part_t *cp = ctx;
     setup(cp);
     if (!cp->ibm || !cp->align) return T;
-    const double margin = 0.125 * dem_contact_time(cp->d); /* t_c/8 */
+    const double tc = dem_contact_time(cp->d), margin = 0.125 * tc; /* t_c/8 */
     /* contacts beyond 1.5 T + t_c/8 cannot change the step: not integrated */
     const double t = dem_time_to_contact(cp->d, 1.5 * T + margin);
-    if (!(t > 2.0 * margin)) return T; /* in contact (the fluid stays frozen over a whole step), or within t_c/4 */
+    if (!(t > 0)) return T; /* in contact: the fluid stays frozen over a whole step */
+    if (!(t > 2.0 * margin)) {
+        /* within t_c/4: the step holds the collision */
+        const double through = t + tc + margin;
+        return cp->align_release && through < T ? through : T;
+    }
     const double aim = t - margin;
     if (aim >= 1.5 * T) return T;
     return aim > T ? 0.5 * aim : aim;
@@ -165,8 +213,7 @@ static double part_stable_dt(void *ctx)
     setup(cp);
     if (!cp->ibm || cp->sim->fluid->prm.dt_fixed > 0) return INFINITY;
     const grid_t *g = cp->ibm->g;
-    double h = fmin(g->dy, g->dim == 3 ? g->dz : g->dy);
-    for (int i = 0; i < g->n[0]; i++) h = fmin(h, g->gdxf[i]);
+    const double h = grid_min_spacing(g);
     const double gg = sqrt(cp->gravity[0] * cp->gravity[0] + cp->gravity[1] * cp->gravity[1] +
                            cp->gravity[2] * cp->gravity[2]);
     const double *r = dem_radii(cp->d);
@@ -218,12 +265,20 @@ static int part_diverged(void *ctx, char *why, size_t n)
 }
 
 /* The tracker's state (exact restarts of the measurements). */
-#define REST_NSTATE 10
+#define REST_NSCALAR 16
+#define REST_NSTATE (REST_NSCALAR + 13)
 static void pack(const restitution_t *r, double *v)
 {
-    const double s[REST_NSTATE] = {r->phase, r->u_last, r->VT, r->VC, r->VR, r->VR_release, r->t_contact, r->t_release,
-                                   r->lub_impulse, r->VC_onset};
+    const double s[REST_NSCALAR] = {r->phase,     r->u_last, r->VT,     r->VC,   r->VR,    r->VR_release,
+                                    r->t_contact, r->t_release, r->lub_impulse, r->VC_onset, r->window, r->V_in,
+                                    r->V_out,     r->apex,   r->t_apex, (double)r->ntraj};
     memcpy(v, s, sizeof s);
+    double *o = v + REST_NSCALAR;
+    memcpy(o, r->cp_last, 3 * sizeof(double));
+    memcpy(o + 3, r->cp_in, 3 * sizeof(double));
+    memcpy(o + 6, r->cp_out, 3 * sizeof(double));
+    memcpy(o + 9, r->vt_out, 3 * sizeof(double));
+    o[12] = r->vn_out;
 }
 
 static void part_checkpoint_write(void *ctx, hid_t grp)
@@ -232,6 +287,7 @@ static void part_checkpoint_write(void *ctx, hid_t grp)
     double v[REST_NSTATE];
     pack(&cp->rest, v);
     io_h5_write_array(grp, "restitution", REST_NSTATE, v);
+    if (cp->rest.ntraj > 0) io_h5_write_array(grp, "restitution_trajectory", 2 * cp->rest.ntraj, cp->rest.traj);
     if (cp->fz.n) {
         io_h5_write_array(grp, "freeze_force", 6L * cp->fz.n, cp->fz.F0);
         io_h5_write_array(grp, "freeze_impulse", 6L * cp->fz.n, cp->fz.J);
@@ -250,6 +306,22 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
     r->phase = (int)v[0];
     r->u_last = v[1], r->VT = v[2], r->VC = v[3], r->VR = v[4], r->VR_release = v[5];
     r->t_contact = v[6], r->t_release = v[7], r->lub_impulse = v[8], r->VC_onset = v[9];
+    r->window = v[10], r->V_in = v[11], r->V_out = v[12], r->apex = v[13], r->t_apex = v[14];
+    const double *o = v + REST_NSCALAR;
+    memcpy(r->cp_last, o, 3 * sizeof(double));
+    memcpy(r->cp_in, o + 3, 3 * sizeof(double));
+    memcpy(r->cp_out, o + 6, 3 * sizeof(double));
+    memcpy(r->vt_out, o + 9, 3 * sizeof(double));
+    r->vn_out = o[12];
+    const long nt = (long)v[15];
+    restitution_free(r);
+    if (nt > 0) {
+        r->captraj = nt;
+        r->traj = xcalloc(2 * (size_t)nt, sizeof(double));
+        if (io_h5_read_array(grp, "restitution_trajectory", 2 * nt, r->traj) != 2 * nt)
+            die("%s: /coupling/restitution_trajectory is missing or has the wrong size", path);
+        r->ntraj = nt;
+    }
     if (cp->fz.n) {
         const long n = cp->fz.n;
         if (io_h5_read_array(grp, "freeze_force", 6 * n, cp->fz.F0) != 6 * n ||
@@ -271,6 +343,18 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
 #define KEY(name) (snprintf(key, sizeof key, "%s.%s", prefix, name), key)
     io_summary_string(y, KEY("fluid"), cp->ibm ? "resolved" : "off");
     io_summary_long(y, KEY("dem_substeps"), cp->substeps);
+    if (cp->num.D > 0) {
+        const coupling_numbers_t *q = &cp->num;
+        io_summary_double(y, KEY("numbers.D"), q->D);
+        io_summary_double(y, KEY("numbers.density_ratio"), q->ratio);
+        io_summary_double(y, KEY("numbers.Ga"), q->Ga);
+        io_summary_double(y, KEY("numbers.V_T_schiller_naumann"), q->V_T);
+        io_summary_double(y, KEY("numbers.Re_T"), q->Re_T);
+        io_summary_double(y, KEY("numbers.St_T"), q->St_T);
+        io_summary_double(y, KEY("numbers.D_over_dx"), q->D_over_h);
+        io_summary_double(y, KEY("numbers.tc_sqrt_g_over_D"), q->tc_g);
+        io_summary_double(y, KEY("numbers.tc_V_T_over_D"), q->tc_VT);
+    }
     io_summary_double(y, KEY("dem_wall_seconds"), cp->wall_dem);
     const restitution_t *r = &cp->rest;
     if (r->mode != RESTITUTION_OFF) {
@@ -289,6 +373,22 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
         io_summary_double(y, KEY("epsilon_over_max"), r->e_dry > 0 ? restitution_epsilon(r) / r->e_dry : 0.0);
         io_summary_double(y, KEY(wall ? "St" : "St_B"), restitution_stokes(r));
         io_summary_double(y, KEY(wall ? "Re_p" : "Re_rel"), restitution_reynolds(r));
+        /* the rebound as an experiment measures it: fits of the trajectory (docs/theory.md §9.3) */
+        io_summary_double(y, KEY("fit_window"), r->window);
+        io_summary_double(y, KEY("V_in"), r->V_in);
+        io_summary_double(y, KEY("V_out"), r->V_out);
+        io_summary_double(y, KEY("epsilon_fit"), restitution_epsilon_fit(r));
+        if (wall) {
+            io_summary_double(y, KEY("apex_over_D"), r->D > 0 ? r->apex / r->D : 0.0);
+            io_summary_double(y, KEY("t_apex_after_release"), r->phase >= 2 ? r->t_apex - r->t_release : 0.0);
+            double psi_in, psi_out, beta, mu_f, angle;
+            restitution_oblique(r, &psi_in, &psi_out, &beta, &mu_f, &angle);
+            io_summary_double(y, KEY("psi_in"), psi_in);
+            io_summary_double(y, KEY("psi_out"), psi_out);
+            io_summary_double(y, KEY("beta"), beta);
+            io_summary_double(y, KEY("mu_f"), mu_f);
+            io_summary_double(y, KEY("rebound_angle_deg"), angle);
+        }
         io_summary_double(y, KEY("t_contact"), r->t_contact);
         io_summary_double(y, KEY("t_release"), r->t_release);
         io_summary_bool(y, KEY("second_contact"), r->phase == 3);
@@ -311,6 +411,7 @@ static int part_done(void *ctx)
     case 0: return r->VT > 0 && fabs(u) < 1e-2 * r->VT && cp->sim->step > 10;
     case 1: return t - r->t_contact > 40 * dem_contact_time(cp->d);
     case 2:
+        if (!restitution_measured(r)) return 0;
         if (r->mode == RESTITUTION_PAIR) return r->VR > 0 && -u < 0.9 * r->VR;
         return u > 0 && r->VR > 0;
     default: return 1;
@@ -323,6 +424,7 @@ static void part_destroy(void *ctx)
     coupling_freeze_free(&cp->fz);
     coupling_added_mass_free(&cp->am);
     coupling_drag_free(&cp->drag);
+    restitution_free(&cp->rest);
     free(cp);
 }
 
@@ -343,12 +445,14 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
     if (mode == RESTITUTION_WALL && axis[0] == 0 && axis[1] == 0 && axis[2] == 0)
         cfg_fail(cfg, "coupling", "restitution_axis", "needed: there is no gravity to take the direction from");
     double mu = 0;
-    if (cfg_has_section(cfg, "fluid")) mu = cfg_double(cfg, "fluid", "rho") * cfg_double(cfg, "fluid", "nu");
-    if (cfg_enum(cfg, "lubrication", "model") == 1 && cfg_double(cfg, "lubrication", "viscosity") > 0)
+    if (cfg_has_section(cfg, "fluid")) mu = cfg_double(cfg, "fluid", "rho") * fluid_nu_from_config(cfg);
+    if (cfg_enum(cfg, "lubrication", "model") != 0 && cfg_double(cfg, "lubrication", "viscosity") > 0)
         mu = cfg_double(cfg, "lubrication", "viscosity");
     /* density, diameter and ε_max of the tracked particle: at setup */
     restitution_init(&cp->rest, (restitution_mode_t)mode, axis, cp->rho_f, mu, 0.0, 0.0, 0.0);
+    cp->rest.fit_window = cfg_double(cfg, "coupling", "fit_window");
     cp->align = cfg_bool(cfg, "coupling", "align_contacts");
+    cp->align_release = cfg_bool(cfg, "coupling", "align_release");
     cp->freeze = cfg_double(cfg, "coupling", "freeze_collisions");
     if (ibm && cp->freeze > 0 && ibm->n > 0) coupling_freeze_init(&cp->fz, ibm->n, 0.0); /* hold time at setup */
     if (ibm && ibm->n > 0 && cfg_enum(cfg, "coupling", "added_mass") == 1)
@@ -357,6 +461,9 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
     if (ibm && ibm->n > 0 && cfg_double(cfg, "coupling", "implicit_drag") > 0)
         coupling_drag_init(&cp->drag, ibm->n, cfg_double(cfg, "coupling", "implicit_drag"),
                            s->fluid->prm.rho * s->fluid->prm.nu);
+    /* the lubrication correction adds what the grid does not resolve: it needs the grid spacing
+     * (before the packing preparation, whose lists must hold every lubricated pair) */
+    if (ibm) dem_lubrication_set_grid(sim_dem_engine_unprepared(s), grid_min_spacing(s->fluid->g));
     sim_part_t part = {
         .name = "coupling",
         .ctx = cp,

@@ -305,8 +305,7 @@ void sim_add_fluid(sim_t *s, cfg_t *cfg)
     fp->ke_now = fluid_kinetic_energy(fp->f);
     fp->div_init = fluid_max_divergence(fp->f);
     const grid_t *g = fp->g;
-    fp->hmin = fmin(g->dy, g->dim == 3 ? g->dz : g->dy);
-    for (int i = 0; i < g->n[0]; i++) fp->hmin = fmin(fp->hmin, g->gdxf[i]);
+    fp->hmin = grid_min_spacing(g);
     fp->volume = g->geom == GEOM_AXI ? M_PI * g->L[0] * g->L[0] * g->L[1] : g->L[0] * g->L[1] * (g->dim == 3 ? g->L[2] : 1.0);
     s->fluid = fp->f;
     sim_part_t part = {

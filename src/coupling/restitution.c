@@ -23,11 +23,23 @@
  * Re = ρ U D/μ  (eq. 3.34–3.35).
  * A contact is on while the tracked particle carries a contact force (the
  * normal force is clipped at zero: the contact ends when it vanishes).
+ *
+ * The rebound as an experiment records it (Gondret et al. 2002, Joseph et
+ * al. 2001 fit the trajectory of the sphere): the gap δ(t) (to the nearest
+ * wall, or between the surfaces of the pair) at every sub-step; V_in is the
+ * slope of the least-squares line through the gaps of the window W before
+ * the contact, V_out the slope through those of the window W after the
+ * release (gsl_fit_linear), ε_fit = V_out/V_in, with W = [coupling]
+ * fit_window or 0.2 D/V_T; and, against a wall, the apex: the largest gap
+ * after the release, and its time.
  */
+#include <gsl/gsl_fit.h>
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "coupling.h"
+#include "util.h"
 
 void restitution_init(restitution_t *r, restitution_mode_t mode, const double axis[3], double rho_f, double mu,
                       double rho_p, double D, double e_dry)
@@ -42,6 +54,84 @@ void restitution_init(restitution_t *r, restitution_mode_t mode, const double ax
     r->D = D;
     r->e_dry = e_dry;
     r->t_contact = r->t_release = -1;
+}
+
+void restitution_free(restitution_t *r)
+{
+    free(r->traj);
+    r->traj = NULL;
+    r->ntraj = r->captraj = 0;
+}
+
+static void traj_add(restitution_t *r, double t, double gap)
+{
+    if (r->ntraj == r->captraj) {
+        r->captraj = r->captraj ? 2 * r->captraj : 1024;
+        double *grown = realloc(r->traj, 2 * (size_t)r->captraj * sizeof(double));
+        if (!grown) die_local("restitution: out of memory for the trajectory (%ld samples)", r->captraj);
+        r->traj = grown;
+    }
+    r->traj[2 * r->ntraj] = t;
+    r->traj[2 * r->ntraj + 1] = gap;
+    r->ntraj++;
+}
+
+/* Slope of the least-squares line through the samples with t in [t0, t1] (0 with fewer than 3). */
+static double traj_slope(const restitution_t *r, double t0, double t1)
+{
+    long k0 = 0, k1 = r->ntraj;
+    while (k0 < r->ntraj && r->traj[2 * k0] < t0) k0++;
+    while (k1 > k0 && r->traj[2 * (k1 - 1)] > t1) k1--;
+    if (k1 - k0 < 3) return 0.0;
+    double c0, c1, cov00, cov01, cov11, sumsq;
+    gsl_fit_linear(r->traj + 2 * k0, 2, r->traj + 2 * k0 + 1, 2, (size_t)(k1 - k0), &c0, &c1, &cov00, &cov01, &cov11,
+                   &sumsq);
+    return c1;
+}
+
+/* Gap of the tracked motion: to the nearest wall, or between the surfaces of the pair. */
+static double tracked_gap(const restitution_t *r, dem_t *d, int i, int j)
+{
+    if (r->mode == RESTITUTION_WALL) return dem_wall_gap_min(d, i);
+    const double *x = dem_positions(d), *rad = dem_radii(d);
+    double l2 = 0;
+    for (int a = 0; a < 3; a++) l2 += (x[3 * j + a] - x[3 * i + a]) * (x[3 * j + a] - x[3 * i + a]);
+    return sqrt(l2) - rad[i] - rad[j];
+}
+
+double restitution_epsilon_fit(const restitution_t *r) { return r->V_in > 0 ? r->V_out / r->V_in : 0.0; }
+
+/* Velocity of the contact point of particle i with the wall, in the wall's plane (axis: towards the wall),
+ * and the centre's velocity there. */
+static void contact_point_velocity(const restitution_t *r, dem_t *d, int i, double cp[3], double vt[3])
+{
+    double v[3];
+    dem_full_velocity(d, i, v);
+    const double *w = dem_omegas(d) + 3 * i, R = dem_radii(d)[i], *n = r->axis;
+    const double wxn[3] = {w[1] * n[2] - w[2] * n[1], w[2] * n[0] - w[0] * n[2], w[0] * n[1] - w[1] * n[0]};
+    const double vn = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+    for (int a = 0; a < 3; a++) {
+        vt[a] = v[a] - vn * n[a];
+        cp[a] = vt[a] + R * wxn[a];
+    }
+}
+
+void restitution_oblique(const restitution_t *r, double *psi_in, double *psi_out, double *beta, double *mu_f,
+                         double *angle_out)
+{
+    *psi_in = *psi_out = *beta = *mu_f = *angle_out = 0.0;
+    if (r->mode != RESTITUTION_WALL || r->phase < 2 || !(r->VC_onset > 0)) return;
+    /* the normal speeds as an experiment measures them (the trajectory fits), when they are made */
+    const int fits = r->V_in > 0 && r->V_out > 0;
+    const double un = fits ? r->V_in : r->VC_onset, e = fits ? r->V_out / r->V_in : r->VR_release / r->VC_onset;
+    const double ut = sqrt(r->cp_in[0] * r->cp_in[0] + r->cp_in[1] * r->cp_in[1] + r->cp_in[2] * r->cp_in[2]);
+    const double vt = sqrt(r->vt_out[0] * r->vt_out[0] + r->vt_out[1] * r->vt_out[1] + r->vt_out[2] * r->vt_out[2]);
+    *angle_out = 180.0 / M_PI * atan2(vt, fits ? r->V_out : r->vn_out);
+    if (!(ut > 1e-9 * un)) return;
+    *psi_in = ut / un;
+    *psi_out = (r->cp_out[0] * r->cp_in[0] + r->cp_out[1] * r->cp_in[1] + r->cp_out[2] * r->cp_in[2]) / ut / un;
+    *beta = -*psi_out / *psi_in;
+    *mu_f = 2.0 * (1.0 + *beta) * *psi_in / (7.0 * (1.0 + e));
 }
 
 /* index of the particle with this id (−1 if absent) */
@@ -115,27 +205,68 @@ void restitution_substep(restitution_t *r, dem_t *d)
     /* lubrication impulse on particle 0 against its approach direction: positive when it
      * pushes the particle back */
     r->lub_impulse -= dem_dt(d) * (fl[0] * dir[0] + fl[1] * dir[1] + fl[2] * dir[2]);
+    const double t = dem_time(d), gap = tracked_gap(r, d, i, j);
     switch (r->phase) {
     case 0:
         if (c) {
             r->phase = 1;
             r->VC_onset = r->u_last;
-            r->t_contact = dem_time(d);
+            r->t_contact = t;
+            if (r->mode == RESTITUTION_WALL) memcpy(r->cp_in, r->cp_last, sizeof r->cp_in);
+            const double V = r->VT > 0 ? r->VT : r->u_last;
+            r->window = r->fit_window > 0 ? r->fit_window : V > 0 ? 0.2 * r->D / V : 0.0;
+            r->V_in = -traj_slope(r, t - r->window, t);
+            r->ntraj = 0;
+        } else if (gap < 0.3 * r->D) {
+            traj_add(r, t, gap); /* the approach, kept from 0.3 D (more than the window's travel) */
+        } else {
+            r->ntraj = 0;
         }
         break;
     case 1:
         if (!c) {
             r->phase = 2;
             r->VR_release = -u;
-            r->t_release = dem_time(d);
+            r->t_release = t;
+            if (r->mode == RESTITUTION_WALL) {
+                contact_point_velocity(r, d, i, r->cp_out, r->vt_out);
+                r->vn_out = -u;
+            }
+            r->ntraj = 0;
+            traj_add(r, t, gap);
+            r->apex = gap;
+            r->t_apex = t;
         }
         break;
     case 2:
-        if (c) r->phase = 3;
+        if (c) {
+            r->phase = 3;
+            break;
+        }
+        if (t <= r->t_release + r->window)
+            traj_add(r, t, gap);
+        else if (r->V_out == 0 && r->ntraj > 0) {
+            r->V_out = traj_slope(r, r->t_release, r->t_release + r->window);
+            r->ntraj = 0;
+        }
+        /* the apex: until the particle turns back towards the wall */
+        if (r->mode == RESTITUTION_WALL && gap > r->apex && u < 0) {
+            r->apex = gap;
+            r->t_apex = t;
+        }
         break;
     default: break;
     }
     r->u_last = u;
+    if (r->mode == RESTITUTION_WALL && r->phase == 0) {
+        double vt[3];
+        contact_point_velocity(r, d, i, r->cp_last, vt);
+    }
+}
+
+int restitution_measured(const restitution_t *r)
+{
+    return r->phase == 3 || (r->phase == 2 && r->V_out != 0);
 }
 
 void restitution_sample(restitution_t *r, dem_t *d)

@@ -180,6 +180,19 @@ dem_status_t dem_set_dt(dem_t *d)
         if (!isfinite(d->tc)) die("dem: no mobile particle: cannot derive the time step from the contact time");
         d->dt = d->tc / d->n_c;
     }
+    /* the tangential lubrication is explicit: its damping rate times the step must stay small
+     * (0.5: the velocity it removes in one step is at most half of what it acts on) */
+    for (int i = 0; i < d->n; i++) {
+        if (d->fixed[i] || d->invm[i] == 0) continue;
+        const double rate = dem_lubrication_tangential_rate(d, d->r[i], 1.0 / d->invm[i]);
+        if (rate * d->dt > 0.5) {
+            snprintf(d->errmsg, sizeof d->errmsg,
+                     "the tangential lubrication of particle %ld damps at %.4g /s: the DEM step %g s must be below "
+                     "%g s (more dem.steps_per_contact, or a larger lubrication.roughness)",
+                     d->id[i], rate, d->dt, 0.5 / rate);
+            return DEM_ERR_TIMESTEP;
+        }
+    }
     return DEM_OK;
 }
 
@@ -193,7 +206,7 @@ void dem_check_scene(dem_t *d)
     }
     d->rmax = rmax;
     /* lubrication: the lists also hold every pair within Δ_lub (lubrication.c) */
-    d->lub.reach = d->lub.on ? d->lub.range * rmax : 0.0;
+    d->lub.reach = dem_lub_reach(&d->lub, rmax);
     if (d->skin_rel > 0)
         d->skin = d->skin_rel * 2 * rmax + d->lub.reach;
     else
@@ -588,6 +601,14 @@ void dem_wall_force(const dem_t *d, int w, double f[3])
     for (int a = 0; a < 3; a++) f[a] = d->wall[w].force[a];
 }
 int dem_wall_active(const dem_t *d, int w) { return d->wall[w].active; }
+double dem_wall_gap_min(const dem_t *d, int i)
+{
+    double g = INFINITY, u;
+    for (int w = 0; w < d->nwall; w++)
+        if (d->wall[w].active) g = fmin(g, dem_wall_gap(d, &d->wall[w], i, &u));
+    return g;
+}
+
 void dem_wall_position(const dem_t *d, int w, double p[3])
 {
     for (int a = 0; a < 3; a++) p[a] = d->wall[w].p[a];

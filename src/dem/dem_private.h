@@ -38,19 +38,31 @@ typedef struct {
     double force[3]; /* force exerted by the particles on the wall, last step */
 } dem_wall_t;
 
-/* Brenner (1961) normal lubrication with an effective roughness (Izard eq.
- * 2.36/3.18, decision 5; lubrication.c): between particles and between a
- * particle and a wall, active for 0 < δ_n ≤ Δ_lub; while they overlap off, or
- * with overlap = saturated at its δ_n = 0 value (eq. 3.26). */
+/* Lubrication (lubrication.c): Brenner's normal force with an effective
+ * roughness (Izard eq. 2.36/3.18, decision 5) and, with model = correction,
+ * the Goldman–Cox–Brenner tangential and rotational terms; between particles
+ * and between a particle and a wall, active for 0 < δ_n below a cut-off; while
+ * they overlap off, or with overlap = saturated at its δ_n = 0 value (eq. 3.26).
+ * model = brenner: the whole force up to Δ_lub = range × R (the seed's form);
+ * model = correction: only what the fluid model does not resolve — below
+ * cutoff × h (h the grid spacing of the resolved fluid, set by the coupling),
+ * each term less its value at the cut-off; without a resolved fluid (h = 0)
+ * the whole force up to range × R. */
+typedef enum { LUB_NONE = 0, LUB_BRENNER = 1, LUB_CORRECTION = 2 } dem_lub_model_t;
 typedef struct {
     int on;
+    int model;           /* dem_lub_model_t */
     int walls;           /* also between a particle and a wall */
     int subtract;        /* subtract the force at δ_n = Δ_lub (the part the grid resolves) */
     int overlap;         /* [lubrication] overlap = saturated: the δ_n = 0 force while overlapping */
+    int tangential;      /* model = correction: the tangential and rotational terms too */
     double viscosity;    /* η_f (Pa s) */
     double roughness;    /* η_e / R */
-    double range;        /* Δ_lub / R */
-    double reach;        /* largest Δ_lub among the particles (m): margin of the lists */
+    double range;        /* Δ_lub / R (brenner; correction without a resolved fluid) */
+    double cutoff;       /* correction: normal cut-off in grid cells */
+    double tcutoff;      /* correction: tangential cut-off in grid cells */
+    double h;            /* grid spacing of the resolved fluid (0: none) */
+    double reach;        /* largest cut-off among the particles (m): margin of the lists */
 } dem_lub_t;
 
 /* Called after every DEM step (dem_set_step_observer). */
@@ -234,6 +246,8 @@ void dem_lubrication_impulses(dem_t *d, double dt);
  * gap0 from approach speed u0 with approach acceleration a under the
  * lubrication (INFINITY: it stops first). */
 double dem_lub_approach_time(const dem_t *d, double R, double reff, double m, double gap0, double u0, double a);
+/* Largest gap at which a particle of radius rmax is lubricated (the margin the lists need). */
+double dem_lub_reach(const dem_lub_t *L, double rmax);
 
 /* ---- pair and wall geometry for the passes outside the force kernel ---- */
 /* Unit normal n from particle i to the partner of its list entry e (the

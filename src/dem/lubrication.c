@@ -49,6 +49,7 @@
 #include <string.h>
 
 #include "dem_private.h"
+#include "fluid.h"
 #include "util.h"
 
 typedef struct {
@@ -115,12 +116,31 @@ static double lub_solve(const lub_pair_t *p, double m, double k, double dt, doub
     return x;
 }
 
+/* The resolved fluid's grid carries the film down to cutoff × h (model =
+ * correction with a grid): the lubrication adds the rest, each term less its
+ * value at the cut-off. */
+static inline int lub_complements_grid(const dem_lub_t *L) { return L->model == LUB_CORRECTION && L->h > 0; }
+
 static inline void lub_params(const dem_lub_t *L, double R, lub_pair_t *p)
 {
     p->eta = L->roughness * R;
-    p->range = L->range * R;
-    p->sub = L->subtract ? 1.0 / (p->range + p->eta) : 0.0;
+    p->range = lub_complements_grid(L) ? L->cutoff * L->h : L->range * R;
+    p->sub = L->subtract || lub_complements_grid(L) ? 1.0 / (p->range + p->eta) : 0.0;
     p->overlap = L->overlap;
+}
+
+/* Cut-off of the tangential terms of a particle of radius R. */
+static inline double lub_tangential_range(const dem_lub_t *L, double R)
+{
+    return lub_complements_grid(L) ? L->tcutoff * L->h : L->range * R;
+}
+
+double dem_lub_reach(const dem_lub_t *L, double rmax)
+{
+    if (!L->on) return 0.0;
+    lub_pair_t p;
+    lub_params(L, rmax, &p);
+    return L->tangential ? fmax(p.range, lub_tangential_range(L, rmax)) : p.range;
 }
 
 /* Time for a lone pair to close its gap from gap0 to 0, at approach speed u0
@@ -169,6 +189,8 @@ double dem_lub_approach_time(const dem_t *d, double R, double reff, double m, do
     lub_params(&d->lub, R, &p);
     return lub_approach_time(&p, m, 6.0 * M_PI * d->lub.viscosity * reff * reff, gap0, u0, a);
 }
+
+static void lub_tangential_impulses(dem_t *d, double dt);
 
 void dem_lubrication_impulses(dem_t *d, double dt)
 {
@@ -221,15 +243,176 @@ void dem_lubrication_impulses(dem_t *d, double dt)
                 }
             }
         }
+    if (L->tangential) lub_tangential_impulses(d, dt);
+}
+
+/* ---- tangential and rotational terms (model = correction) ----------------
+ *
+ * Goldman, Cox & Brenner (1967) for a sphere and a plane, and their
+ * extension to two spheres of radii R_i and R_j = κR_i (Jeffrey & Onishi
+ * 1984, in the form of Simeonov & Calantoni 2012), leading (logarithmic)
+ * terms only, each less its value at the cut-off δ_t = tcutoff × h:
+ * with ℓ = ln((δ_t + η_e)/(δ + η_e)) for 0 < δ < δ_t, n the unit normal
+ * from i towards j (or the wall), u₁₂ = v_j − v_i, u_t its part normal to n,
+ *
+ *   F_i = 6πμR_i ℓ [a_tt u₁₂,t − R_i a_tr (ω_i + ω_j + 4ω_i/κ + 4κω_j) × n],
+ *   T_i = 8πμR_i² ℓ [b_tt n × u₁₂ − R_i b_tr (ω_i + κω_j/4)_t],
+ *   a_tt = 4κ(2 + κ + 2κ²)/(15(1 + κ)³),  a_tr = 2κ²/(15(1 + κ)²),
+ *   b_tt = κ(4 + κ)/(10(1 + κ)²),         b_tr = 2κ/(5(1 + κ)),
+ *
+ * F_j = −F_i and T_j by exchanging i and j (κ → 1/κ, n → −n).  κ → ∞ is the
+ * wall (at rest in rotation, moving with its velocity): a_tt = 8/15, a_tr =
+ * 2/15, b_tt = 1/10, b_tr = 2/5 — GCB's coefficients.  The resistance is
+ * symmetric and positive (tests/test_dem_lubrication.c checks that every
+ * random motion dissipates), logarithmic only: not stiff, so these impulses
+ * are explicit, applied with the normal ones before the drift, pair after
+ * pair in list order; dem_lubrication_check_step bounds the step.  The
+ * rotation about n is left out (Simeonov & Calantoni 2012: negligible). */
+
+/* Impulses of the tangential terms of one sphere–sphere pair over dt. */
+static void lub_tangential_pair(dem_t *d, int i, int j, const double n[3], double ell, double mu, double dt)
+{
+    const double ri = d->r[i], rj = d->r[j];
+    double *v = d->v, *w = d->w, *fl = d->flub;
+    double u12[3], un = 0;
+    for (int a = 0; a < 3; a++) {
+        u12[a] = v[3 * j + a] - v[3 * i + a];
+        un += u12[a] * n[a];
+    }
+    double ut[3];
+    for (int a = 0; a < 3; a++) ut[a] = u12[a] - un * n[a];
+    /* force and torque on a particle p of radius rp against q of radius rq = κ rp, normal m from p to q */
+    double F[3], Ti[3], Tj[3];
+    for (int side = 0; side < 2; side++) {
+        const int p = side ? j : i, q = side ? i : j;
+        const double rp = side ? rj : ri, kap = (side ? ri : rj) / rp, s = side ? -1.0 : 1.0;
+        const double att = 4 * kap * (2 + kap + 2 * kap * kap) / (15 * pow(1 + kap, 3));
+        const double atr = 2 * kap * kap / (15 * (1 + kap) * (1 + kap));
+        const double btt = kap * (4 + kap) / (10 * (1 + kap) * (1 + kap)), btr = 2 * kap / (5 * (1 + kap));
+        const double *wp = w + 3 * p, *wq = w + 3 * q;
+        double m[3], o[3], tw[3], uts[3];
+        for (int a = 0; a < 3; a++) {
+            m[a] = s * n[a];
+            uts[a] = s * ut[a]; /* v_q − v_p, tangential */
+            o[a] = wp[a] + wq[a] + 4 * wp[a] / kap + 4 * kap * wq[a];
+            tw[a] = wp[a] + kap * wq[a] / 4;
+        }
+        const double twn = tw[0] * m[0] + tw[1] * m[1] + tw[2] * m[2];
+        const double ox = o[1] * m[2] - o[2] * m[1], oy = o[2] * m[0] - o[0] * m[2], oz = o[0] * m[1] - o[1] * m[0];
+        const double mux[3] = {m[1] * uts[2] - m[2] * uts[1], m[2] * uts[0] - m[0] * uts[2], m[0] * uts[1] - m[1] * uts[0]};
+        const double cf = 6 * M_PI * mu * rp * ell, ct = 8 * M_PI * mu * rp * rp * ell;
+        const double oxv[3] = {ox, oy, oz};
+        double *T = side ? Tj : Ti;
+        for (int a = 0; a < 3; a++) {
+            if (!side) F[a] = cf * (att * uts[a] - rp * atr * oxv[a]);
+            T[a] = ct * (btt * mux[a] - rp * btr * (tw[a] - twn * m[a]));
+        }
+    }
+    const double imi = d->invm[i] * dt, imj = d->invm[j] * dt, iIi = d->invI[i] * dt, iIj = d->invI[j] * dt;
+    for (int a = 0; a < 3; a++) {
+        v[3 * i + a] += F[a] * imi;
+        v[3 * j + a] -= F[a] * imj;
+        w[3 * i + a] += Ti[a] * iIi;
+        w[3 * j + a] += Tj[a] * iIj;
+        fl[3 * i + a] += F[a];
+        fl[3 * j + a] -= F[a];
+    }
+}
+
+/* The same for particle i and a wall of unit normal nw (into the domain) moving with vel. */
+static void lub_tangential_wall(dem_t *d, int i, const double nw[3], const double vel[3], double ell, double mu,
+                                double dt)
+{
+    const double R = d->r[i];
+    double *v = d->v + 3 * i, *w = d->w + 3 * i, *fl = d->flub + 3 * i;
+    double n[3], u[3], un = 0, wn = 0;
+    for (int a = 0; a < 3; a++) {
+        n[a] = -nw[a]; /* towards the wall */
+        u[a] = v[a] - vel[a];
+        un += u[a] * n[a];
+        wn += w[a] * n[a];
+    }
+    double ut[3], wt[3];
+    for (int a = 0; a < 3; a++) {
+        ut[a] = u[a] - un * n[a];
+        wt[a] = w[a] - wn * n[a];
+    }
+    const double wxn[3] = {w[1] * n[2] - w[2] * n[1], w[2] * n[0] - w[0] * n[2], w[0] * n[1] - w[1] * n[0]};
+    const double nxu[3] = {n[1] * ut[2] - n[2] * ut[1], n[2] * ut[0] - n[0] * ut[2], n[0] * ut[1] - n[1] * ut[0]};
+    const double cf = 6 * M_PI * mu * R * ell, ct = 8 * M_PI * mu * R * R * ell;
+    const double im = d->invm[i] * dt, iI = d->invI[i] * dt;
+    for (int a = 0; a < 3; a++) {
+        const double F = -cf * (8.0 / 15.0 * ut[a] + 2.0 / 15.0 * R * wxn[a]);
+        const double T = -ct * (0.1 * nxu[a] + 0.4 * R * wt[a]);
+        v[a] += F * im;
+        w[a] += T * iI;
+        fl[a] += F;
+    }
+}
+
+/* ℓ of the tangential terms at gap δ (0 outside 0 < δ < δ_t). */
+static inline double lub_tangential_log(double delta, double range, double eta)
+{
+    return delta > 0 && delta < range ? log((range + eta) / (delta + eta)) : 0.0;
+}
+
+static void lub_tangential_impulses(dem_t *d, double dt)
+{
+    const dem_lub_t *L = &d->lub;
+    const double *invm = d->invm, *r = d->r;
+    for (int i = 0; i < d->nb_n_rows; i++)
+        for (long e = d->nb_start[i]; e < d->nb_start[i + 1]; e++) {
+            const int j = d->nb_j[e];
+            if (invm[i] == 0 && invm[j] == 0) continue;
+            double n[3];
+            const double R = r[i] < r[j] ? r[i] : r[j], gap = dem_pair_normal(d, i, e, n) - r[i] - r[j];
+            const double ell = lub_tangential_log(gap, lub_tangential_range(L, R), L->roughness * R);
+            if (ell > 0) lub_tangential_pair(d, i, j, n, ell, L->viscosity, dt);
+        }
+    if (L->walls)
+        for (int k = 0; k < d->nwall; k++) {
+            const dem_wall_t *W = &d->wall[k];
+            if (!W->active) continue;
+            for (int q = 0; q < W->nlist; q++) {
+                const int i = W->idx[q];
+                if (invm[i] == 0) continue;
+                double u;
+                const double gap = dem_wall_gap(d, W, i, &u);
+                const double ell = lub_tangential_log(gap, lub_tangential_range(L, r[i]), L->roughness * r[i]);
+                if (ell > 0) lub_tangential_wall(d, i, W->n, W->vel, ell, L->viscosity, dt);
+            }
+        }
+}
+
+double dem_lubrication_tangential_rate(const dem_t *d, double R, double m)
+{
+    const dem_lub_t *L = &d->lub;
+    if (!L->on || !L->tangential) return 0.0;
+    /* the largest damping rate of the explicit terms, at δ = 0: the rotation
+     * of a sphere against a wall, (8πμR³ (2/5) ℓ)/(2/5 m R²) = 8πμR ℓ/m */
+    const double ell = log((lub_tangential_range(L, R) + L->roughness * R) / (L->roughness * R));
+    return 8 * M_PI * L->viscosity * R * ell / m;
 }
 
 static const cfg_key_t lub_keys[] = {
-    {"lubrication", "model", CFG_ENUM, "none", 1, 0, "none|brenner",
-     "normal lubrication between particles and with walls: none, or brenner (eq. 3.18 with roughness)"},
+    {"lubrication", "model", CFG_ENUM, "none", 1, 0, "none|brenner|correction",
+     "lubrication between particles and with walls: none; brenner (the seed's eq. 3.18: the whole normal force up to "
+     "range x R); correction (only what the fluid model does not resolve: with the resolved fluid the normal and "
+     "tangential terms below cutoff and tangential_cutoff grid cells, each less its value there; without it the whole "
+     "force up to range x R)"},
     {"lubrication", "roughness", CFG_DOUBLE, "2e-4", 1e-12, 1, NULL, "effective roughness eta_e / R"},
-    {"lubrication", "range", CFG_DOUBLE, "0.5", 1e-6, 10, NULL, "activation distance Delta_lub / R (gap 0 < delta <= Delta_lub)"},
+    {"lubrication", "range", CFG_DOUBLE, "0.5", 1e-6, 10, NULL,
+     "activation distance Delta_lub / R (gap 0 < delta <= Delta_lub) of brenner, and of correction without a resolved fluid"},
+    {"lubrication", "cutoff", CFG_DOUBLE, "1.1", 0.01, 100, NULL,
+     "correction with the resolved fluid: normal cut-off in grid cells (the gap below which the grid no longer carries "
+     "the film force; 1.1 measured for the immersed boundary, docs/theory.md)"},
+    {"lubrication", "tangential_cutoff", CFG_DOUBLE, "0.6", 0.01, 100, NULL,
+     "correction with the resolved fluid: cut-off of the tangential and rotational terms in grid cells (0.6 "
+     "measured, docs/theory.md)"},
+    {"lubrication", "tangential", CFG_BOOL, "true", 1, 0, NULL,
+     "correction: also the Goldman-Cox-Brenner tangential and rotational terms (logarithmic)"},
     {"lubrication", "subtract_resolved", CFG_BOOL, "false", 1, 0, NULL,
-     "subtract the force at the activation distance (the part a resolved fluid already carries)"},
+     "brenner: subtract the force at the activation distance (the part a resolved fluid already carries)"},
     {"lubrication", "overlap", CFG_ENUM, "off", 1, 0, "off|saturated",
      "lubrication while the particles overlap: off (decision 5), or saturated (the force keeps its delta = 0 value "
      "-6 pi eta_f R^2 u_n / eta_e: the contact damping of eq. 3.26)"},
@@ -245,21 +428,38 @@ void dem_lubrication_config(dem_t *d, cfg_t *cfg)
 {
     dem_lub_t *L = &d->lub;
     memset(L, 0, sizeof *L);
-    L->on = cfg_enum(cfg, "lubrication", "model") == 1;
+    L->model = cfg_enum(cfg, "lubrication", "model");
+    L->on = L->model != LUB_NONE;
     if (!L->on) return;
     L->roughness = cfg_double(cfg, "lubrication", "roughness");
     L->range = cfg_double(cfg, "lubrication", "range");
     L->subtract = cfg_bool(cfg, "lubrication", "subtract_resolved");
     L->walls = cfg_bool(cfg, "lubrication", "walls");
     L->overlap = cfg_enum(cfg, "lubrication", "overlap") == 1;
+    if (L->model == LUB_CORRECTION) {
+        L->cutoff = cfg_double(cfg, "lubrication", "cutoff");
+        L->tcutoff = cfg_double(cfg, "lubrication", "tangential_cutoff");
+        L->tangential = cfg_bool(cfg, "lubrication", "tangential");
+        if (L->subtract)
+            cfg_fail(cfg, "lubrication", "subtract_resolved",
+                     "is for model = brenner: correction subtracts the value at its cut-off by itself");
+    }
     L->viscosity = cfg_double(cfg, "lubrication", "viscosity");
     if (L->viscosity < 0) {
         if (!cfg_has_section(cfg, "fluid"))
             cfg_fail(cfg, "lubrication", "viscosity",
                      "needed: the scene has no [fluid] section to take rho nu from (a dry DEM with lubrication)");
-        L->viscosity = cfg_double(cfg, "fluid", "rho") * cfg_double(cfg, "fluid", "nu");
+        L->viscosity = cfg_double(cfg, "fluid", "rho") * fluid_nu_from_config(cfg);
     }
-    if (!(L->viscosity > 0)) cfg_fail(cfg, "lubrication", "viscosity", "must be positive with model = brenner");
+    if (!(L->viscosity > 0)) cfg_fail(cfg, "lubrication", "viscosity", "must be positive with lubrication");
+}
+
+void dem_lubrication_set_grid(dem_t *d, double h)
+{
+    d->lub.h = h;
+    if (d->lub.model == LUB_CORRECTION && h > 0)
+        msg("lubrication: correction below %.3g (normal) and %.3g (tangential%s) grid cells of %.4g\n", d->lub.cutoff,
+            d->lub.tcutoff, d->lub.tangential ? "" : ": off", h);
 }
 
 const double *dem_lubrication_forces(const dem_t *d) { return d->flub; }

@@ -284,7 +284,6 @@ void fluid_update_diagnostics(fluid_t *f, const double *stats, const double *div
     f->diag.ke = g->geom == GEOM_AXI ? 2.0 * M_PI * e : e;
     f->diag.cfl = f->diag.dt * glob[1];
     /* |D u| relative to the largest velocity over the smallest cell */
-    double dmin = fmin(g->dy, g->dim == 3 ? g->dz : g->dy);
-    for (int i = 0; i < g->n[0]; i++) dmin = fmin(dmin, g->gdxf[i]);
+    const double dmin = grid_min_spacing(g);
     f->diag.div_max = glob[2] > 0 ? glob[0] * dmin / glob[2] : glob[0];
 }

@@ -9,7 +9,9 @@
 #include "util.h"
 
 static const cfg_key_t fluid_keys[] = {
-    {"fluid", "nu", CFG_DOUBLE, NULL, 1e-300, 1e300, NULL, "kinematic viscosity ν = η/ρ (> 0)"},
+    {"fluid", "nu", CFG_DOUBLE, NULL, 1e-300, 1e300, NULL, "kinematic viscosity ν = η/ρ (> 0); or give mu"},
+    {"fluid", "mu", CFG_DOUBLE, NULL, 1e-300, 1e300, NULL,
+     "dynamic viscosity η (Pa s), instead of nu (ν = η/ρ)"},
     {"fluid", "rho", CFG_DOUBLE, "1", 1e-300, 1e300, NULL,
      "fluid density (the solver uses the kinematic pressure p/ρ; ρ scales forces and output)"},
     {"fluid", "body_force", CFG_VEC3, "0 0 0", -1e300, 1e300, NULL,
@@ -39,10 +41,17 @@ static const cfg_key_t fluid_keys[] = {
 
 void fluid_register_keys(void) { cfg_schema_add(fluid_keys); }
 
+double fluid_nu_from_config(cfg_t *cfg)
+{
+    if (!cfg_has(cfg, "fluid", "mu")) return cfg_double(cfg, "fluid", "nu");
+    if (cfg_has(cfg, "fluid", "nu")) cfg_fail(cfg, "fluid", "mu", "give nu or mu, not both");
+    return cfg_double(cfg, "fluid", "mu") / cfg_double(cfg, "fluid", "rho");
+}
+
 void fluid_params_from_config(cfg_t *cfg, const grid_t *g, fluid_params_t *prm)
 {
     memset(prm, 0, sizeof *prm);
-    prm->nu = cfg_double(cfg, "fluid", "nu");
+    prm->nu = fluid_nu_from_config(cfg);
     prm->rho = cfg_double(cfg, "fluid", "rho");
     cfg_vec3(cfg, "fluid", "body_force", prm->body_force);
     prm->implicit_viscous = cfg_enum(cfg, "fluid", "viscous") == 1;

@@ -318,3 +318,10 @@ double grid_cell_volume(const grid_t *g, int i)
     if (g->geom == GEOM_AXI) return g->xc[i] * g->dxf[i] * g->dy;
     return g->dxf[i] * g->dy * (g->dim == 3 ? g->dz : 1.0);
 }
+
+double grid_min_spacing(const grid_t *g)
+{
+    double h = fmin(g->dy, g->dim == 3 ? g->dz : g->dy);
+    for (int i = 0; i < g->n[0]; i++) h = fmin(h, g->gdxf[i]);
+    return h;
+}
