@@ -36,6 +36,8 @@ def num(c, sec, key, default=None):
 
 
 def status(run):
+    if not os.path.exists(f"{OUT}/{run}.rc"):
+        return "not run"
     log = open(f"{OUT}/{run}.log").read()
     m = re.search(r"diverged at step (\d+) \(t = ([0-9.e+-]+)", log)
     if m:
@@ -73,7 +75,7 @@ def mean_ke(d, t0, t1):
 runs = [line.split("|")[0] for line in open(f"{OUT}/runs.list")]
 rows = []
 for run in runs:
-    if not os.path.exists(f"{OUT}/{run}/series.csv"):
+    if not os.path.exists(f"{OUT}/{run}.rc") or not os.path.exists(f"{OUT}/{run}/series.csv"):
         rows.append((run, status(run), "", "", "", "", "", "", "", ""))
         continue
     c, d = cfg_of(run), series(run)
@@ -82,10 +84,12 @@ for run in runs:
     vn = dt.max() * nu / hmin(c) ** 2
     taus, ov, jg, res = "", "", "", ""
     if "particles" in c:
-        rho, rp = num(c, "fluid", "rho", 1.0), num(c, "particles", "density", 2500)
+        rho, rp = num(c, "fluid", "rho", 1.0), num(c, "particles", "density", None)
         r = num(c, "particles", "radius", None)
-        if r is None:
-            r = 0.5 * float(c["particles"]["particle1"].split("diameter")[1].split()[0])
+        if r is None or rp is None:  # a list of particles: the first one's
+            p1 = c["particles"]["particle1"]
+            r = 0.5 * float(p1.split("diameter")[1].split()[0])
+            rp = float(p1.split("density")[1].split()[0])
         tau = (rp + 0.5 * rho) * (2 * r) ** 2 / (18 * rho * nu)
         taus = f"{dt.max() / tau:.2g}"
         ov = f"{100 * d['dem_max_overlap'].max():.3f}"

@@ -25,7 +25,8 @@ R100="--set fluid.rho=25 --set fluid.nu=9.6e-3 --set particles.density=2500"
 {
     # name | case | --set overrides
     echo "sq_after_0.01|$SQ|--set ibm.cn_forcing=after_solve --set fluid.dt_max=0.01"
-    for dt in 0.05 0.25 1; do
+    echo "sq_pred_0.01|$SQ|--set fluid.dt_max=0.01"
+    for dt in 0.05 0.1 0.25 1; do
         echo "sq_after_$dt|$SQ|--set ibm.cn_forcing=after_solve --set fluid.dt_max=$dt"
         echo "sq_pred_$dt|$SQ|--set fluid.dt_max=$dt"
     done
@@ -34,14 +35,20 @@ R100="--set fluid.rho=25 --set fluid.nu=9.6e-3 --set particles.density=2500"
         echo "free_${c}_0.01|$VS/free_axi.ini|--set ibm.cn_forcing=$c --set fluid.dt_max=0.01"
         echo "free_${c}_cfl|$VS/free_axi.ini|--set ibm.cn_forcing=$c"
     done
+    echo "free_explicit|$VS/free_axi.ini|--set fluid.viscous=explicit"
     echo "single_K0|$VS/single.ini|--set coupling.implicit_drag=0"
     echo "single_K4|$VS/single.ini|"
     echo "single_ref|$VS/single.ini|--set fluid.dt_max=3.2e-4"
+    echo "single_after_K4|$VS/single.ini|--set ibm.cn_forcing=after_solve"
+    echo "single_after_ref|$VS/single.ini|--set ibm.cn_forcing=after_solve --set fluid.dt_max=3.2e-4"
+    echo "single_explicit_ref|$VS/single.ini|--set fluid.viscous=explicit --set coupling.implicit_drag=0"
     echo "settle_K0|$VS/settle.ini|--set coupling.implicit_drag=0 --set time.t_end=0.3"
-    echo "settle_K4|$VS/settle.ini|"
+    echo "settle_K4|$VS/settle.ini|--set time.t_end=0.3"
     echo "settle_ref|$VS/settle.ini|--set coupling.implicit_drag=0 --set fluid.dt_max=3.2e-4 --set time.t_end=0.3"
     echo "settle25_K4|$VS/settle.ini|$R25 --set time.t_end=0.5"
     echo "settle100_after_K0|$VS/settle.ini|$R100 --set ibm.cn_forcing=after_solve --set coupling.implicit_drag=0 --set time.t_end=0.5"
+    echo "settle100_after_K4|$VS/settle.ini|$R100 --set ibm.cn_forcing=after_solve --set time.t_end=0.5"
+    echo "settle100_K0|$VS/settle.ini|$R100 --set coupling.implicit_drag=0 --set time.t_end=0.5"
     echo "settle100_K4|$VS/settle.ini|$R100 --set time.t_end=0.5"
     echo "pack_K2|$VS/pack.ini|--set coupling.implicit_drag=2 --set time.t_end=1.5"
     echo "pack_K4|$VS/pack.ini|"
