@@ -3,7 +3,7 @@
 #   make test       install missing Debian packages, build, run the test suite (1 and 2 ranks)
 #   make demo       install, build, run the built-in demo case and plot it
 #   make validate   full-size validation cases (long)
-#   make restitution  restitution sweeps of issue 5 (wall and binary; 1.3 min on 2 cores, measured in session 8);
+#   make restitution  restitution sweeps (wall and binary; about 15 min on 2 cores);
 #                   RESTITUTION_SET='section.key=value ...' overrides keys in every run,
 #                   RESTITUTION_OUT=dir the output directory (default build/restitution)
 #   make viscous_stability  the stability map of the coupled step at large viscous numbers
@@ -26,11 +26,17 @@ BUILD   ?= build
 OPT     := -O3 -march=native -g
 endif
 CFLAGS  := $(STD) $(OPT) $(WARN) -Iinclude $(HDF5_CFLAGS) $(EXTRA_CFLAGS)
-LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -linih -lgsl -lgslcblas -lqhull_r -lcholmod -lsuitesparseconfig -lm -fopenmp
+LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -linih -lgsl -lgslcblas -lqhull_r -lcholmod -lsuitesparseconfig \
+           -lgmp -lmpfr -lstdc++ -lm -fopenmp
+# C++ (CGAL's regular triangulation, src/porenet/regular_cgal.cpp): interval
+# arithmetic of the exact predicates needs -frounding-math
+CXX     := g++
+CXXFLAGS := -std=c++17 $(OPT) -Wall -Wextra -frounding-math -Iinclude $(EXTRA_CFLAGS)
 TESTLIBS := -lcmocka
 
 SRC     := $(filter-out src/main.c,$(shell find src -name '*.c' | sort))
-OBJ     := $(patsubst src/%.c,$(BUILD)/obj/%.o,$(SRC))
+CXXSRC  := $(shell find src -name '*.cpp' | sort)
+OBJ     := $(patsubst src/%.c,$(BUILD)/obj/%.o,$(SRC)) $(patsubst src/%.cpp,$(BUILD)/obj/%.o,$(CXXSRC))
 DEP     := $(OBJ:.o=.d)
 LIB     := $(BUILD)/libibmdem.a
 BIN     := $(BUILD)/ibmdem
@@ -43,6 +49,10 @@ all: $(BIN) $(TESTS) $(BENCHES)
 $(BUILD)/obj/%.o: src/%.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -MMD -MP -c $< -o $@
+
+$(BUILD)/obj/%.o: src/%.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS) -MMD -MP -c $< -o $@
 
 # The DEM kernels take square roots of non-negative numbers only: without errno
 # handling the contact loop of src/dem/dem_kernel.inc vectorises (SIMD).  The
@@ -89,7 +99,7 @@ bench: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bash bench/run.sh
 
-# restitution curves of the bouncing sphere and the binary collision (issue 5): the sweep in
+# restitution curves of the bouncing sphere and the binary collision: the sweep in
 # parallel on the available cores, build/restitution/{restitution,binary}.{csv,png}, target checks
 RESTITUTION_OUT ?= $(BUILD)/restitution
 restitution: deps

@@ -19,13 +19,17 @@
  *     reported on its own.
  *
  * The permeability is computed with both models of the throats in the wall
- * planes (porenet.wall_throats = mirror, the default, and yade); the coupled
- * step uses the default.  Times: CPU time of the process (the machine is
- * shared) and wall time.  Prints "RESULT ibmdem_perm ..." (one per model) and
+ * planes (porenet.wall_throats = mirror, the default, and yade), with the CPU
+ * time of each part (triangulation, network, factorisation, solve) and of the
+ * whole; then once more with the mirror model and the earlier engine (qhull,
+ * METIS ordering, images out to 6 r_max), whose kappa the default must give to
+ * round-off.  The coupled step uses the default.  Times: CPU time of the
+ * process (the machine is shared) and wall time.  Prints "RESULT ibmdem_perm ..." (one per model) and
  * "RESULT ibmdem_step ..." lines.  Extra "key = value" arguments go into
  * [porenet] of every part.
  *
  * usage: bench_porenet_yade N PACKING_OUT STEPS [key=value ...]
+ * (REUSE=1 with PACKING_OUT present: the packing is read from it)
  */
 #include <math.h>
 #include <stdio.h>
@@ -74,11 +78,29 @@ int main(int argc, char **argv)
     const char *out = argv[2];
     const int steps = atoi(argv[3]);
     double *x = malloc(3 * (size_t)n * sizeof *x), *r = malloc((size_t)n * sizeof *r);
-    const double L = make_packing(n, 0.58, 0.05, 99 + n, 1, x, r);
+    /* REUSE=1 and the file exists: read the packing back (a repeated measurement, interleaved with
+     * YADE's, without the cost of making it again) */
+    FILE *in = getenv("REUSE") && atoi(getenv("REUSE")) ? fopen(out, "r") : NULL;
+    double L = 0;
+    if (in) {
+        char line[512];
+        int k = 0;
+        while (fgets(line, sizeof line, in) && k <= n) {
+            if (line[0] == '#') {
+                double b0, b1, b2;
+                if (sscanf(line, "# box %lf %lf %lf %lf", &b0, &b1, &b2, &L) != 4) continue;
+            } else if (k < n && sscanf(line, "%lf %lf %lf %lf", x + 3 * k, x + 3 * k + 1, x + 3 * k + 2, r + k) == 4)
+                k++;
+        }
+        fclose(in);
+        if (k != n || !(L > 0)) die("%s: not a packing of %d spheres", out, n);
+    } else {
+        L = make_packing(n, 0.58, 0.05, 99 + n, 1, x, r);
+    }
     double worst = 0;
     for (int i = 0; i < n; i++)
         for (int a = 0; a < 3; a++) worst = fmax(worst, fmax(r[i] - x[3 * i + a], x[3 * i + a] + r[i] - L));
-    if (mpi_rank() == 0) {
+    if (mpi_rank() == 0 && !in) {
         FILE *f = fopen(out, "w");
         if (!f) die("cannot write %s", out);
         fprintf(f, "# %d spheres, radii 1 +- 5 %%, solid fraction 0.58, walled box (bench_porenet_yade)\n", n);
@@ -87,26 +109,39 @@ int main(int argc, char **argv)
         fclose(f);
     }
 
-    /* 1. permeability of the fixed packing, with both models of the wall-plane throats */
-    static const char *const model[2] = {"mirror", "yade"};
-    for (int wm = 0; wm < 2; wm++) {
-        char flow[512];
+    /* 1. permeability of the fixed packing, with both models of the wall-plane throats; then the
+     * mirror model again with the previous engine (qhull, METIS, images out to 6 r_max): the
+     * same kappa to round-off */
+    static const char *const model[3] = {"mirror", "yade", "mirror"};
+    static const char *const engine[3] = {"", "", "triangulation = qhull\nordering = metis\nmargin = %.17g\n"};
+    double kappa0 = 0, rmax = 0;
+    for (int i = 0; i < n; i++) rmax = fmax(rmax, r[i]);
+    for (int wm = 0; wm < 3; wm++) {
+        char flow[1024], eng[256];
+        snprintf(eng, sizeof eng, engine[wm], 6 * rmax);
         snprintf(flow, sizeof flow,
                  "z_lo_flow = pressure\nz_lo_value = 1\nz_hi_flow = pressure\nz_hi_value = 0\n"
-                 "x_lo = slip\nx_hi = slip\ny_lo = slip\ny_hi = slip\nz_lo = slip\nz_hi = slip\nwall_throats = %s\n",
-                 model[wm]);
+                 "x_lo = slip\nx_hi = slip\ny_lo = slip\ny_hi = slip\nz_lo = slip\nz_hi = slip\nwall_throats = %s\n%s",
+                 model[wm], eng);
         cfg_t *cfg = make_cfg(L, flow, argc - 4, argv + 4);
         pn_model_t m;
         pn_model_from_config(cfg, &m);
+        const double c0 = cputime();
         if (pn_model_step(&m, n, x, r, 0.0)) die("porenet: %s", m.err);
+        const double c_total = cputime() - c0;
         const double kappa = pn_model_permeability(&m, 2);
+        if (wm == 0) kappa0 = kappa;
         double q[6];
         pn_face_fluxes(&m.dom, &m.net, m.p, q);
+        /* CPU times of the parts: triangulation, network (geometry, conductances), factorisation
+         * (assembly, ordering, Cholesky), solve (right-hand side, back-substitution) */
         if (mpi_rank() == 0)
-            printf("RESULT ibmdem_perm N= %d wall_throats= %s L= %.10g kappa= %.10e kappa/d2= %.10e Q_in= %.10e "
-                   "Q_out= %.10e pores= %d throats= %d tri_s= %.4g net_s= %.4g factor_s= %.4g wall_overlap= %.2e\n",
-                   n, model[wm], L, kappa, kappa / 4.0, q[4], -q[5], m.net.npore, m.net.nthroat, m.t_tri, m.t_net,
-                   m.t_factor, fmax(worst, 0));
+            printf("RESULT ibmdem_perm N= %d wall_throats= %s engine= %s L= %.10g kappa= %.10e kappa/d2= %.10e Q_in= %.10e "
+                   "Q_out= %.10e pores= %d throats= %d tri_s= %.4g net_s= %.4g factor_s= %.4g solve_s= %.4g total_s= %.4g "
+                   "points= %d margin_rmax= %.3g wall_overlap= %.2e kappa_rel_to_first= %.2e\n",
+                   n, model[wm], wm == 2 ? "qhull+metis+6rmax" : "default", L, kappa, kappa / 4.0, q[4], -q[5], m.net.npore,
+                   m.net.nthroat, m.t_tri, m.t_net, m.t_factor, m.t_solve, c_total, m.tri.npts, m.tri.margin / rmax,
+                   fmax(worst, 0), kappa / kappa0 - 1);
         fflush(stdout);
         pn_model_free(&m);
         cfg_free(cfg);

@@ -67,17 +67,32 @@ def scene(flow_on):
     return flow
 
 
-# 1. permeability (the DEM does not move: one step with the integrator off)
+# 1. permeability (the DEM does not move: one step with the integrator off).  CPU time of the
+# step, split by YADE's own timers (wall-clock nanoseconds of each engine and of FlowEngine's
+# checkpoints "Triangulating": triangulation, cells, volumes, conductances; "Factorize + Solve"):
+# the CPU time of a part is the step's CPU time times its share of the timed wall time (one
+# thread: the shares of the CPU time, up to the machine's preemptions)
 flow = scene(True)
 flow.bndCondIsPressure = [0, 0, 0, 0, 1, 1]
 flow.bndCondValue = [0, 0, 0, 0, 1, 0]
 O.engines[-1].dead = True
+O.timingEnabled = True
+c0 = time.process_time()
 O.step()
+cpu_step = time.process_time() - c0
+O.timingEnabled = False
+t_all = sum(e.execTime for e in O.engines)
+deltas = {d[0]: d[1] for d in flow.timingDeltas.data}
+share = cpu_step / t_all if t_all > 0 else 0.0
+cpu_flow = flow.execTime * share
+cpu_tri_net = deltas.get("Triangulating", 0) * share
+cpu_factor_solve = deltas.get("Factorize + Solve", 0) * share
 q_in, q_out = flow.getBoundaryFlux(4), flow.getBoundaryFlux(5)
 Q = 0.5 * (abs(q_in) + abs(q_out))
 kappa = flow.viscosity * Q * L[2] / (1.0 * L[0] * L[1])
-print("RESULT yade_perm N= %d L= %.10g kappa= %.10e kappa/d2= %.10e Q_in= %.10e Q_out= %.10e cells= %d clamp= %d" %
-      (n, L[2], kappa, kappa / 4.0, q_in, q_out, flow.nCells(), clamp))
+print("RESULT yade_perm N= %d L= %.10g kappa= %.10e kappa/d2= %.10e Q_in= %.10e Q_out= %.10e cells= %d clamp= %d "
+      "cpu_step_s= %.5g cpu_flow_s= %.5g cpu_tri_net_s= %.5g cpu_factor_solve_s= %.5g" %
+      (n, L[2], kappa, kappa / 4.0, q_in, q_out, flow.nCells(), clamp, cpu_step, cpu_flow, cpu_tri_net, cpu_factor_solve))
 sys.stdout.flush()
 
 # 2. coupled step, and the dry DEM step of the same scene

@@ -49,7 +49,7 @@ if want multigrid; then
     for np in 1 2; do run multigrid_np$np $MPIRUN -np $np "$BUILD/bench/bench_mg" "$N"; done
 fi
 if want porenet && [ -x "$BUILD/bench/bench_porenet" ]; then
-    run porenet $MPIRUN -np 1 "$BUILD/bench/bench_porenet" 5000 20000 80000
+    run porenet $MPIRUN -np 1 "$BUILD/bench/bench_porenet" 5000 20000 50000
     # against YADE's FlowEngine on the same packings (installs yade)
     run porenet_yade bash bench/porenet_vs_yade.sh
     [ -f "$BUILD/bench_porenet_yade/porenet_yade.md" ] &&

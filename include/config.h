@@ -66,6 +66,12 @@ void cfg_fail(const cfg_t *c, const char *section, const char *key, const char *
 typedef void (*cfg_error_hook_t)(const char *msg);
 void cfg_set_error_hook(cfg_error_hook_t hook);
 
+/* Call fn for every key given (file or --set) that no getter has read, in
+ * the order given (line 0: --set).  A run notes them in its log: keys of a
+ * model the scene does not use. */
+void cfg_foreach_unused(const cfg_t *c, void (*fn)(const char *section, const char *key, int line, void *ctx),
+                        void *ctx);
+
 /* Write every key that was read (with its resolved value and whether it came
  * from the file, --set or the default) and every given key, as an INI file. */
 void cfg_write_resolved(const cfg_t *c, FILE *f);

@@ -127,6 +127,13 @@ static inline int dem_in_contact(const dem_t *d, int i)
 void dem_lubrication_register_keys(void);
 /* Lubrication force on each particle in the last step (impulse / dt), 3n. */
 const double *dem_lubrication_forces(const dem_t *d);
+/* The drag closure of the fluid model drag (drag.c, [drag]). */
+void dem_drag_register_keys(void);
+/* Local solid fraction φ of each particle and its drag force in the last
+ * step (3 per particle), indexed by particle id (dem_ids); NULL without the
+ * drag. */
+const double *dem_drag_fraction(const dem_t *d);
+const double *dem_drag_forces(const dem_t *d);
 /* The grid spacing of the resolved fluid (model = correction adds only what it
  * does not resolve, below a cut-off in grid cells); 0: no resolved fluid. */
 void dem_lubrication_set_grid(dem_t *d, double h);

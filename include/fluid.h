@@ -63,11 +63,19 @@ extern const double fluid_rk_gamma[3], fluid_rk_zeta[3];
  * Hagen–Poiseuille on a uniform grid). */
 typedef enum { WALL_GHOST_LINEAR = 0, WALL_GHOST_QUADRATIC = 1 } wall_ghost_t;
 
+/* The viscous term (fluid_params_t implicit_viscous): explicit in the RK3
+ * stages, Crank–Nicolson, or chosen per step (auto): explicit when its
+ * stability limit allows the step the other limits set (or more than
+ * 1/viscous_auto_ratio of it: an implicit step costs more), implicit
+ * otherwise (docs/theory.md §1). */
+enum { FLUID_VISCOUS_EXPLICIT = 0, FLUID_VISCOUS_IMPLICIT = 1, FLUID_VISCOUS_AUTO = 2 };
+
 typedef struct {
     double nu;            /* kinematic viscosity */
     double rho;           /* density (for forces and output in physical units) */
     double body_force[3]; /* acceleration driving the flow (e.g. a pressure gradient) */
-    int implicit_viscous; /* 1: Crank–Nicolson, 0: explicit */
+    int implicit_viscous; /* FLUID_VISCOUS_*: 0 explicit, 1 Crank–Nicolson, 2 auto (per step, fluid_stable_dt) */
+    double viscous_auto_ratio; /* auto: implicit when the other limits allow more than this × the explicit limit */
     wall_ghost_t wall_ghost; /* no-slip wall closure of the viscous term */
     double cfl;           /* convective CFL target of the adaptive step */
     double fourier;       /* viscous stability target (explicit only) */
@@ -109,6 +117,9 @@ struct fluid {
      * c and local x plane i is ũ = u*[m] + a fluid_laplacian_at(f, c, pred_u[c], i, m) */
     const double *pred_u[3];
     double pred_a;
+    int implicit_step;    /* the viscous term of the current (or last) step is Crank–Nicolson */
+    long implicit_steps;  /* steps taken with it (viscous = auto: the others were explicit) */
+    double dt_viscous;    /* the explicit viscous limit (fourier target; INFINITY without viscosity) */
     void *priv;           /* work arrays and solvers of the implementation */
 };
 

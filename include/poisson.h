@@ -91,6 +91,8 @@ poisson_t *poisson_create(const grid_t *g, var_loc_t loc, const poisson_opts_t *
 /* The operator alone, without a solver back-end: poisson_apply and
  * poisson_fill_ghosts work, poisson_solve does not (explicit viscous term). */
 poisson_t *poisson_create_operator(const grid_t *g, var_loc_t loc);
+/* Give an operator its solver back-end (as poisson_create does; nothing if it has one). */
+void poisson_add_solver(poisson_t *p, const poisson_opts_t *opt);
 void poisson_free(poisson_t *p);
 
 /* Solve (L − λI) x = b.  b and x are fields of the grid (x may equal b);

@@ -10,8 +10,8 @@
  *
  * Three stages, each behind a small interface:
  *   pn_triangulate   regular triangulation of the spheres and their images
- *                    (periodic copies, mirror copies across walls) — qhull's
- *                    4-D lift (triangulate.c)
+ *                    (periodic copies, mirror copies across walls) — CGAL's
+ *                    Regular_triangulation_3 or qhull's 4-D lift (triangulate.c)
  *   pn_network_build pores (tetrahedra with coincident power centres merged),
  *                    throats, geometry, conductances, force coefficients
  *                    (network.c)
@@ -36,6 +36,7 @@
 #ifndef IBMDEM_PORENET_H
 #define IBMDEM_PORENET_H
 
+#include <hdf5.h>
 #include <stddef.h>
 
 /* Flow boundary condition of a wall face (face f = 2*axis + side, side 0 = lo). */
@@ -69,14 +70,23 @@ typedef struct {
     double *cond;       /* conditioning of each power-centre solve (|det| relative to the scale³; 0: hyperplane) */
     int *grp;           /* qhull facet the tetrahedron was split from (Qt: co-spherical set), or -1 */
     double margin;      /* width of the image layer */
+    double margin_needed; /* the width the tetrahedra of the box need (≤ margin) */
     int n_flat;         /* lower facets whose tetrahedron is flat (power centre from the hyperplane) */
 } pn_tri_t;
 
 /* Regular triangulation of n spheres (x: 3n, r: n) in the domain.  Returns 0,
  * or -1 with a reason in err (a centre inside another sphere or outside the
- * box, qhull failure).  margin <= 0: 3 maximum diameters. */
+ * box, qhull failure).  The image layer is `margin` wide (<= 0: 2.75 maximum
+ * radii), widened when the tetrahedra of the box need more, up to 6 maximum
+ * radii or `margin` (t->margin: the width used; t->margin_needed <= t->margin:
+ * every pore of the box is exact). */
 int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double *r, double margin, pn_tri_t *t,
                    char *err, size_t nerr);
+/* The triangulation engine: CGAL's Regular_triangulation_3 (exact predicates;
+ * the default, pn_triangulate) or qhull's 4-D lift (option Qt). */
+typedef enum { PN_TRI_CGAL = 0, PN_TRI_QHULL } pn_tri_kind_t;
+int pn_triangulate_with(const pn_domain_t *dom, int n, const double *x, const double *r, double margin,
+                        pn_tri_kind_t kind, pn_tri_t *t, char *err, size_t nerr);
 void pn_tri_free(pn_tri_t *t);
 /* Position of extended point `p` for sphere positions x (images follow their sphere). */
 void pn_tri_point(const pn_domain_t *dom, const pn_tri_t *t, const double *x, int p, double out[3]);
@@ -153,11 +163,20 @@ typedef struct pn_solver pn_solver_t;
  * defined up to a constant).  Returns NULL with err on failure. */
 pn_solver_t *pn_solver_create(const pn_domain_t *dom, const pn_net_t *net, pn_solver_kind_t kind, double pcg_tol,
                               char *err, size_t nerr);
+/* The same with a choice of the fill-reducing ordering of CHOLMOD: METIS
+ * (pn_solver_create), or geometric nested dissection of the pores' positions
+ * (ordering.c: cheaper to compute, more fill; for a system solved once). */
+typedef enum { PN_ORDER_METIS = 0, PN_ORDER_GEOMETRIC } pn_ordering_t;
+pn_solver_t *pn_solver_create_ordered(const pn_domain_t *dom, const pn_net_t *net, pn_solver_kind_t kind,
+                                      pn_ordering_t ordering, double pcg_tol, char *err, size_t nerr);
 void pn_solver_free(pn_solver_t *s);
 /* Pressures (p: npore) for pore volume rates dvdt (npore, NULL: zero, rigid
  * skeleton) and the domain's boundary values.  Returns 0, or -1 if PCG did not
  * converge. */
 int pn_solve(pn_solver_t *s, const pn_domain_t *dom, const pn_net_t *net, const double *dvdt, double *p);
+/* The unknowns' values of the last solve (the PCG's starting guess of the
+ * next one) set from pore pressures p (a restart continues as the run). */
+void pn_solver_set_solution(pn_solver_t *s, const double *p, int npore);
 /* Iterations of the last PCG solve (0 for CHOLMOD); time of the factorisation. */
 int pn_solver_iterations(const pn_solver_t *s);
 double pn_solver_factor_time(const pn_solver_t *s);
@@ -190,9 +209,13 @@ typedef struct {
     pn_domain_t dom;
     pn_params_t prm;
     pn_solver_kind_t kind;
+    pn_tri_kind_t tri_kind; /* porenet.triangulation */
+    pn_ordering_t ordering; /* porenet.ordering (auto resolved: geometric for a fixed packing) */
     double pcg_tol;
     double eps_retri;   /* re-triangulate when Σ_steps max_i |ΔV_i/V_i| exceeds this (thesis 5.13–5.14); 0: every step */
     double margin;      /* image layer (0: auto) */
+    int margin_warned;  /* warned once: 1 the given margin was widened, 2 some pores need more than the widest */
+    double margin_used; /* the width of the last triangulation (the next one starts from it) */
     double rho_f;       /* fluid density (Reynolds number, buoyancy) */
     int n;
     pn_tri_t tri;
@@ -200,6 +223,7 @@ typedef struct {
     pn_solver_t *sol;
     int built;
     double *p, *vol, *vol_prev, *dvdt, *x_prev;
+    double *x_tri;      /* positions the current triangulation and network were built for (checkpoints) */
     int vol_current;    /* vol holds the pore volumes at x_prev on the current topology (the next step's start) */
     double *f, *fp, *fv; /* fp, fv: filled by pn_write_snapshot only */
     double *x_cont;     /* previous positions continuous with the current ones (periodic unwrapping) */
@@ -230,6 +254,16 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r);
  * Re-triangulates when due, solves, computes m->f.  0 or -1 (m->err). */
 int pn_model_step(pn_model_t *m, int n, const double *x, const double *r, double dt);
 void pn_model_free(pn_model_t *m);
+/* The model's exact state in an HDF5 group of a checkpoint (state.c): the
+ * positions of the last triangulation, the previous positions and pore
+ * volumes, the strain accumulated since the triangulation, the pressures,
+ * the forces and the snapshot index.  pn_model_state_read rebuilds the
+ * triangulation from the saved positions (the same network and
+ * factorisation) and restores the rest, so that the next step is the one of
+ * the run that wrote it; r: the radii (n spheres, in the model's order).
+ * 0, or -1 with m->err. */
+int pn_model_state_write(const pn_model_t *m, hid_t group);
+int pn_model_state_read(pn_model_t *m, hid_t group, int n, const double *r);
 
 /* ---- coupling with the DEM engine (couple.c) ------------------------------------- */
 
@@ -242,6 +276,13 @@ struct dem;
  * pressures; the model's forces act through the centres: zero torque).
  * dt <= 0: rigid skeleton (the initial state).  0 or -1 (m->err). */
 int pn_model_couple_dem(pn_model_t *m, struct dem *d, const double g[3], double dt);
+/* The fluid force of the last step (m->f) plus the buoyancy −ρ_f V g into
+ * dem_ext_force() (the second half of pn_model_couple_dem; a restart applies
+ * the saved forces with it). */
+void pn_model_apply_forces(const pn_model_t *m, struct dem *d, const double g[3]);
+/* m->xid, m->rid: the DEM's positions and radii in the order of the
+ * particle ids (the first half of pn_model_couple_dem). */
+void pn_model_gather(pn_model_t *m, const struct dem *d);
 /* Time-step limit of the coupled problem, ζ · min_k Δt_{M−V} with the viscous
  * limit of each mobile particle Δt_{M−V} = π ρ_k d_k²/(1200 μ) = M_k/(200 μ d_k)
  * (thesis 4.19–4.22, β = 400 calibrated for d_max/d_min ≤ 10). */

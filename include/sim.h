@@ -25,6 +25,7 @@
 
 #include "config.h"
 #include "io.h"
+#include "porenet.h"
 
 #define SIM_MAX_PARTS 8
 #define SIM_MAX_COLS 96
@@ -126,6 +127,7 @@ struct sim {
     char *input;             /* resolved input (text) */
     uint64_t fingerprint;
     int check_only;
+    int fluid_model;         /* fluid_model_t of the scene ([coupling] fluid) */
 };
 
 void sim_register_keys(void);
@@ -134,6 +136,10 @@ void sim_register_keys(void);
  * state; with restart != NULL, continue from that checkpoint.  check_only:
  * validate and build without creating any output (ibmdem check). */
 sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only);
+/* The parts of the scene for its fluid model (sim_scene.c, called from sim_create). */
+void sim_build_scene(sim_t *s, cfg_t *cfg);
+/* Note in the log the keys of the case the run has not read (after its first step). */
+void sim_note_unused(const sim_t *s);
 /* Add a part (called from sim_create). */
 void sim_add_part(sim_t *s, const sim_part_t *part);
 /* Run to the end; returns the exit status: 0 when the run finished (t_end,
@@ -149,7 +155,7 @@ extern const char *const sim_run_control_keys[];
 /* Add cell fields to the fluid's snapshots (see sim_field_writer_t). */
 void sim_add_field_writer(sim_t *s, sim_field_writer_t fn, void *ctx);
 
-/* The fluid part (sim_fluid.c): built when the case has a [fluid] section. */
+/* The fluid part (sim_fluid.c): built for the resolved fluid model. */
 void sim_add_fluid(sim_t *s, cfg_t *cfg);
 /* The DEM part (sim_dem.c): built when the case has a [particles] section. */
 void sim_add_dem(sim_t *s, cfg_t *cfg);
@@ -157,8 +163,15 @@ void sim_add_dem(sim_t *s, cfg_t *cfg);
 struct dem *sim_dem_engine(sim_t *s);
 /* The same before the packing preparation (while building the scene). */
 struct dem *sim_dem_engine_unprepared(sim_t *s);
-/* The pore-network fluid (sim_porenet.c): built when the case has a [porenet] section. */
+/* The pore-network fluid (sim_porenet.c): built for the porenet fluid model. */
 void sim_add_porenet(sim_t *s, cfg_t *cfg);
+/* Its model (NULL without it), and a function called once before its first solve. */
+pn_model_t *sim_porenet_model(sim_t *s);
+void sim_porenet_before_start(sim_t *s, void (*fn)(void *ctx), void *ctx);
+/* The oedometer protocol of a pore-network + DEM scene ([oedometer], sim_oedometer.c:
+ * Terzaghi's consolidation), added after the network. */
+void sim_add_oedometer(sim_t *s, cfg_t *cfg);
+void sim_oedometer_register_keys(void);
 /* The immersed-boundary part (sim_ibm.c): built when the case has an [ibm]
  * section; needs the fluid (its stage hooks do the work). */
 void sim_add_ibm(sim_t *s, cfg_t *cfg);
@@ -171,7 +184,7 @@ void sim_dem_set_driven(sim_t *s);
  * and the restitution measurements. */
 void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm);
 void sim_coupling_register_keys(void);
-/* The case has a [fluid] section and [coupling] fluid is not off. */
+/* The scene's fluid model is the resolved fluid ([coupling] fluid, fluid_model.h). */
 int sim_fluid_enabled(cfg_t *cfg);
 
 #endif

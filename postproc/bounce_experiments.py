@@ -51,9 +51,13 @@ def main():
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, len(pairs), figsize=(6 * len(pairs), 4.2), squeeze=False)
-    for ax, pair in zip(axes[0], pairs):
+    # one panel per experiment: the runs compared with the same data are drawn over each other
+    datasets = list(dict.fromkeys(p.split(":")[1] for p in pairs))
+    fig, axes = plt.subplots(1, len(datasets), figsize=(7 * len(datasets), 4.4), squeeze=False)
+    drawn = set()
+    for n_run, pair in enumerate(pairs):
         d, data = pair.split(":")
+        ax = axes[0][datasets.index(data)]
         s, c, D, t, gap, v = load_run(d)
         g = 9.81
         tref = np.sqrt(D / g)
@@ -89,13 +93,16 @@ def main():
                          apex1_exp=ae[0][1] / D if ae else np.nan, apex1_run=ar[0][1] / D if ar else np.nan,
                          t_apex1_exp=ae[0][0] if ae else np.nan, t_apex1_run=ar[0][0] if ar else np.nan,
                          secant_exp=e_exp, secant_run=e_run, rms_gap_over_D=rms))
-        ax.plot(te / tref, ge / D, "ko", ms=3.5, mfc="none", label="Gondret et al. (2002), digitised")
-        ax.plot(ts / tref, gap / D, "C0-", lw=1.3, label=f"ibmdem, D/dx = {c['numbers']['D_over_dx']:.0f}")
-        ax.set_xlim(te.min() / tref - 0.3, te.max() / tref + 0.3)
-        ax.set_ylim(-0.05, max(ge.max(), gap[ts > te.min()].max()) / D * 1.15)
-        ax.set_xlabel(r"$t/\sqrt{D/g}$")
-        ax.set_ylabel(r"gap$/D$")
-        ax.set_title(f"St = {c['St']:.0f}")
+        if data not in drawn:
+            drawn.add(data)
+            ax.plot(te / tref, ge / D, "ko", ms=3.5, mfc="none", label="Gondret et al. (2002), digitised", zorder=3)
+            ax.set_xlim(te.min() / tref - 0.3, te.max() / tref + 0.3)
+            ax.set_ylim(-0.05, max(ge.max(), gap[ts > te.min()].max()) / D * 1.15)
+            ax.set_xlabel(r"$t/\sqrt{D/g}$")
+            ax.set_ylabel(r"gap$/D$")
+            ax.set_title(f"St = {c['St']:.0f}")
+        ax.plot(ts / tref, gap / D, f"C{n_run % 10}-", lw=1.2,
+                label=f"ibmdem {name}, D/dx = {c['numbers']['D_over_dx']:.0f}")
         ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(out_png, dpi=130)

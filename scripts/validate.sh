@@ -60,7 +60,7 @@ fi
 # --- porenet: permeameter cases (fixed packings), summary values, ParaView
 d=$(mktemp -d)
 if "$BUILD/ibmdem" run cases/permeameter/periodic.ini --out "$d/per" >/dev/null 2>&1 &&
-   "$BUILD/ibmdem" run cases/permeameter/permeameter.ini --out "$d/wal" >/dev/null 2>&1; then
+   "$BUILD/ibmdem" run cases/permeameter/permeameter.ini --set porenet.snapshots=on --out "$d/wal" >/dev/null 2>&1; then
     /usr/bin/python3 - "$d" <<'PY' || fail "porenet permeameter"
 import json, sys
 d = sys.argv[1]
@@ -84,33 +84,43 @@ fi
 rm -rf "$d"
 
 # --- porenet: Terzaghi consolidation in an oedometer (cases/consolidation/oedometer.ini,
-# 600 spheres, 22 grains high; catalano_pfv.md §5.4): p at mid-height and at the sealed base
-# and U_corr (the settlement with the initial compression removed by Taylor's sqrt(t) method,
-# ASTM D2435) and U_marker (the settlement of the grains 1-2 d below the piston over their dry
-# settlement, against the series of the sub-layer below them; no correction)
-# against the series at T_v = 0.1, 0.2, 0.5, 1 within ±0.05 (PN_TOL), E_oed and
-# kappa measured on the same packing; the raw U is printed, not asserted (it is 0.069 above the
-# series at T_v = 0.1: docs/validation.md); figure consolidation.png.  About 63 000 coupled
-# steps (~3 min of CPU).  Then the coarse column (300 spheres) to T_v = 0.2 with the default
-# re-triangulation criterion (1 %) and re-triangulating at every step: within 0.02 of dsigma
-# and of the settlement (PN_TOL=1: only that comparison is asserted there).
-# consolidation NAME WHAT VAR=VALUE...: the test with these settings, its numbers, its figure
-consolidation() {
-    local name=$1 what=$2
-    shift 2
-    env "$@" PN_SERIES="$OUT/$name.csv" $MPIRUN -np 1 "$BUILD/tests/test_porenet_consolidation" \
-        >"$OUT/$name.txt" 2>&1
-    local rc=$?
-    grep '^#' "$OUT/$name.txt"
-    /usr/bin/python3 postproc/plot_consolidation.py "$OUT/$name.csv" "$OUT/$name.png"
-    [ "$rc" = 0 ] || fail "$what"
-}
+# 600 spheres, 22 grains high, `ibmdem run` with [oedometer]; catalano_pfv.md §5.4): p at
+# mid-height and at the sealed base and U_corr (the settlement with the initial compression
+# removed by Taylor's sqrt(t) method, ASTM D2435) and U_marker (the settlement of the grains 1-2 d
+# below the piston over their dry settlement, against the series of the sub-layer below them; no
+# correction) against the series at T_v = 0.1, 0.2, 0.5, 1 within ±0.05, E_oed and kappa measured
+# on the same packing; the raw U is printed, not asserted (it is 0.069 above the series at
+# T_v = 0.1: docs/validation.md); figure consolidation.png.  About 63 000 coupled steps (~3 min of
+# CPU).  Then the coarse column (300 spheres) to T_v = 0.2 with the default re-triangulation
+# criterion (1 %) and re-triangulating at every step: within 0.02 of dsigma and of the settlement.
 section "porenet: Terzaghi consolidation (oedometer, 600 spheres)"
-consolidation consolidation "porenet consolidation (Terzaghi within 0.05)" \
-    PN_CASE=cases/consolidation/oedometer.ini PN_TOL=0.05
+"$BUILD/ibmdem" run cases/consolidation/oedometer.ini --set output.progress=off --out "$OUT/consolidation" \
+    >"$OUT/consolidation.txt" 2>&1 || fail "porenet consolidation run"
+/usr/bin/python3 postproc/plot_consolidation.py "$OUT/consolidation.png" "$OUT/consolidation"
+/usr/bin/python3 - "$OUT/consolidation/summary.json" <<'PY' || fail "porenet consolidation (Terzaghi within 0.05)"
+import json, sys
+o = json.load(open(sys.argv[1]))["oedometer"]
+print("consolidation: deviation %.4f (p_mid, p_base, U_corr), marker %.4f: target 0.05" % (o["deviation"], o["deviation_marker"]))
+sys.exit(0 if o["Tv_points"] == 4 and o["deviation"] < 0.05 and o["deviation_marker"] < 0.05 and o["p_base_max"] > 0.95 else 1)
+PY
 section "porenet: consolidation, 1 % re-triangulation criterion against every step"
-consolidation consolidation_retri "porenet consolidation (1 % against every step)" \
-    PN_REFERENCE=1 PN_TV_MAX=0.2 PN_TOL=1
+for r in default every_step; do
+    set=""
+    [ $r = every_step ] && set="--set porenet.retriangulate=0"
+    "$BUILD/ibmdem" run cases/consolidation/coarse.ini --set output.progress=off --set oedometer.tv_end=0.2 $set \
+        --out "$OUT/consolidation_retri_$r" >"$OUT/consolidation_retri_$r.txt" 2>&1 || fail "porenet consolidation $r"
+done
+/usr/bin/python3 postproc/plot_consolidation.py "$OUT/consolidation_retri.png" "$OUT/consolidation_retri_default" \
+    "$OUT/consolidation_retri_every_step"
+/usr/bin/python3 - "$OUT" <<'PY' || fail "porenet consolidation (1 % against every step)"
+import json, sys
+a, b = (json.load(open(sys.argv[1] + "/consolidation_retri_%s/summary.json" % r)) for r in ("default", "every_step"))
+worst = max(abs(a["oedometer"][t][q] - b["oedometer"][t][q]) for t in ("Tv_0_1", "Tv_0_2")
+            for q in ("p_mid", "p_base", "U", "U_marker"))
+print("re-triangulating every step: %d triangulations (default %d), largest difference %.4f (of dsigma, of dH): target 0.02"
+      % (b["porenet"]["triangulations"], a["porenet"]["triangulations"], worst))
+sys.exit(0 if worst < 0.02 else 1)
+PY
 
 
 # --- fluid: lid-driven cavity series, Re = 100 (Crank-Nicolson) and Re = 1000

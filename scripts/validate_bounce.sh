@@ -8,7 +8,7 @@
 #     .csv); checks: St 27 apex within 5 % of the experiment at every resolution, the change between the
 #     two finest < 5 % (apex and epsilon_fit), halving the fluid step moves epsilon and epsilon_fit by
 #     < 0.02; St 152 is printed with MISS when its apex or secant is off by more than 5 % / 0.05
-#     (docs/validation.md: the immersed boundary at Re 160 needs more than D/dx = 30);
+#     (docs/validation.md: the immersed boundary at Re 160 needs more than D/dx = 40);
 #  3. the oblique sweep (scripts/oblique_sweep.sh, 5 angles).
 # usage: scripts/validate_bounce.sh   (OUT, BUILD, FULL from the environment)
 cd "$(dirname "$0")/.."

@@ -527,3 +527,15 @@ void cfg_write_resolved(const cfg_t *c, FILE *f)
     }
     free(list);
 }
+
+/* ---- keys not read ---------------------------------------------------------- */
+
+void cfg_foreach_unused(const cfg_t *c, void (*fn)(const char *section, const char *key, int line, void *ctx), void *ctx)
+{
+    for (int i = 0; i < c->n; i++) {
+        const entry_t *e = &c->e[i];
+        /* the entry in force (--set overrides the file), given, and never read */
+        if (find(c, e->section, e->key) != e || !strcmp(e->origin, "default") || e->used) continue;
+        fn(e->section, e->key, e->line, ctx);
+    }
+}

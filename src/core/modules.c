@@ -2,6 +2,7 @@
 #include "modules.h"
 
 #include "dem.h"
+#include "fluid_model.h"
 #include "fluid.h"
 #include "ibm.h"
 #include "grid.h"
@@ -19,5 +20,8 @@ void modules_register_keys(void)
     sim_register_keys();
     dem_register_keys();
     dem_lubrication_register_keys();
+    dem_drag_register_keys();
     sim_coupling_register_keys();
+    fluid_model_register_keys();
+    sim_oedometer_register_keys();
 }

@@ -173,35 +173,8 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
      * checkpoint's FFTW wisdom before it plans) */
     if (restart) snprintf(s->restart_path, sizeof s->restart_path, "%s", restart);
 
-    /* Parts of the scene, in the order they advance. */
-    if (sim_fluid_enabled(cfg)) sim_add_fluid(s, cfg);
-    const int particles = cfg_has_section(cfg, "particles");
-    /* resolved coupling: the particles are immersed spheres of the fluid */
-    const int resolved = s->fluid && particles && !cfg_has_section(cfg, "porenet");
-    if (resolved) {
-        sim_add_dem(s, cfg);
-        sim_dem_set_driven(s);
-        int n = 0;
-        ibm_sphere_t *sp = coupling_spheres_of_particles(sim_dem_engine_unprepared(s), &n);
-        struct ibm *ibm = sim_add_ibm_with(s, cfg, sp, n);
-        free(sp);
-        sim_add_coupling(s, cfg, ibm);
-    } else {
-        if (cfg_has_section(cfg, "ibm")) {
-            if (!s->fluid)
-                cfg_fail(cfg, "ibm", "sphere1", "an immersed boundary needs a fluid: the case has no [fluid] section");
-            sim_add_ibm(s, cfg);
-        }
-        if (particles) sim_add_dem(s, cfg);
-        if (particles && cfg_enum(cfg, "coupling", "restitution") != 0) sim_add_coupling(s, cfg, NULL);
-    }
-    if (cfg_has_section(cfg, "porenet")) sim_add_porenet(s, cfg);
-
-    if (s->npart == 0) {
-        if (mpi_rank() == 0) fprintf(stderr, "%s: nothing to simulate: the case has no [fluid] or [particles] section (with at least one key)\n", cfg_path(cfg));
-        MPI_Finalize();
-        exit(2);
-    }
+    /* Parts of the scene, in the order they advance, for its fluid model. */
+    sim_build_scene(s, cfg);
 
     /* Everything has been read: the resolved input and its fingerprint. */
     s->input = io_resolved_input(cfg);
@@ -447,6 +420,7 @@ int sim_run(sim_t *s)
         /* 2. advance every part by dt (fluid: fluid_step, three RK3 stages,
          *    each projected to a divergence-free velocity) */
         advance(s, dt);
+        if (s->step == s->step0 + 1) sim_note_unused(s); /* every part has read its keys */
         /* 3. diagnostics and checks; a diverged run stops with a checkpoint */
         if (diverged(s)) return stop_diverged(s);
         /* 4. the outputs due at this step */
@@ -456,14 +430,17 @@ int sim_run(sim_t *s)
     io_progress_clear(&s->progress);
     if (s->last_series_step != s->step) write_series_row(s);
     if (s->last_fields_step != s->step) write_fields(s);
-    if (s->last_checkpoint_step != s->step) write_checkpoint(s);
+    /* a scene whose parts have no state (a fixed packing solved once) has nothing to restart from */
+    int state = 0;
+    for (int i = 0; i < s->npart; i++) state |= s->part[i].checkpoint_write != NULL;
+    if (s->last_checkpoint_step != s->step && state) write_checkpoint(s);
     write_summary(s);
     static const char *why[] = {"", "reached t_end", "reached max_steps", "reached the wall-time limit",
                                 "reached a steady state", "", "has what it was run for (a part is done)"};
     double wall = wtime() - s->wall0;
     msg("%s: %s at step %ld, t = %.10g (%ld steps in %.3g s, %.4g steps/s); checkpoint %s\n", s->prm.name,
         why[s->status], s->step, s->time, s->step - s->step0, wall, wall > 0 ? (s->step - s->step0) / wall : 0.0,
-        s->last_checkpoint);
+        s->last_checkpoint[0] ? s->last_checkpoint : "none (no part has a state to restart from)");
     return 0;
 }
 

@@ -6,9 +6,8 @@
  * fluid step (which forced the spheres where they were) this part hands the
  * hydrodynamic forces to the DEM, advances the DEM over the fluid step with
  * its own sub-steps (the DEM part is then driven from here), and moves the
- * spheres.  [coupling] fluid = off ignores the [fluid] section: a dry DEM
- * run (lubrication still acts if [lubrication] model = brenner, with its
- * viscosity).  [coupling] restitution = wall|pair adds the bounce
+ * spheres.  The fluid model is [coupling] fluid (fluid_model.h); without the
+ * resolved fluid the part only measures bounces: [coupling] restitution = wall|pair adds the bounce
  * measurements (restitution.c) to the time series and summary.json, in
  * coupled and dry runs alike.
  */
@@ -17,13 +16,11 @@
 #include <string.h>
 
 #include "coupling.h"
+#include "fluid_model.h"
 #include "sim.h"
 #include "util.h"
 
 static const cfg_key_t coupling_keys[] = {
-    {"coupling", "fluid", CFG_ENUM, "resolved", 1, 0, "resolved|off",
-     "resolved: particles are immersed spheres of the [fluid] (DEM sub-cycled in each fluid step); "
-     "off: ignore [fluid], dry DEM (with [lubrication] if set)"},
     {"coupling", "restitution", CFG_ENUM, "off", 1, 0, "off|wall|pair",
      "measure a bounce: particle 0 against a wall (V_T, V_C, V_R, epsilon, St, Re_p) or particles 0 and 1 (epsilon_B, St_B)"},
     {"coupling", "stop_after_rebound", CFG_BOOL, "false", 1, 0, NULL,
@@ -49,7 +46,8 @@ static const cfg_key_t coupling_keys[] = {
      "fluid step; consistent: they act on m_p + C_M rho V_p (Izard eqs. 3.24, 3.26) and the fluid's reaction "
      "C_M rho V_p dU/dt_f to the velocity change they made is removed from the next held force (docs/theory.md §9.1)"},
     {"coupling", "added_mass_coefficient", CFG_DOUBLE, "0.5", 0, 10, NULL,
-     "added_mass = consistent: C_M (1/2, a sphere in unbounded fluid, the seed's value for walls and pairs)"},
+     "added_mass = consistent: C_M (1/2, a sphere in unbounded fluid, the seed's value for walls and pairs; "
+     "0.803, a sphere touching a wall or the symmetry plane of two equal spheres, docs/theory.md §9.1)"},
     {"coupling", "implicit_drag", CFG_DOUBLE, "0", 0, 1e6, NULL,
      "K > 0: inside the DEM sub-steps the held hydrodynamic force and torque respond to the particle's velocity "
      "change since the fluid step, -K 3 pi eta D (U - U_n) and -K pi eta D^3 (omega - omega_n), so that a particle "
@@ -62,7 +60,7 @@ static const cfg_key_t coupling_keys[] = {
 
 void sim_coupling_register_keys(void) { cfg_schema_add(coupling_keys); }
 
-int sim_fluid_enabled(cfg_t *cfg) { return cfg_has_section(cfg, "fluid") && cfg_enum(cfg, "coupling", "fluid") == 0; }
+int sim_fluid_enabled(cfg_t *cfg) { return fluid_model_of(cfg) == FLUID_MODEL_RESOLVED; }
 
 typedef struct {
     sim_t *sim;
@@ -446,7 +444,8 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
         cfg_fail(cfg, "coupling", "restitution_axis", "needed: there is no gravity to take the direction from");
     double mu = 0;
     if (cfg_has_section(cfg, "fluid")) mu = cfg_double(cfg, "fluid", "rho") * fluid_nu_from_config(cfg);
-    if (cfg_enum(cfg, "lubrication", "model") != 0 && cfg_double(cfg, "lubrication", "viscosity") > 0)
+    if (fluid_model_lubrication(cfg) && cfg_enum(cfg, "lubrication", "model") != 0 &&
+        cfg_double(cfg, "lubrication", "viscosity") > 0)
         mu = cfg_double(cfg, "lubrication", "viscosity");
     /* density, diameter and ε_max of the tracked particle: at setup */
     restitution_init(&cp->rest, (restitution_mode_t)mode, axis, cp->rho_f, mu, 0.0, 0.0, 0.0);

@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "dem.h"
+#include "fluid_model.h"
 #include "sim.h"
 #include "util.h"
 
@@ -200,7 +201,8 @@ void sim_add_dem(sim_t *s, cfg_t *cfg)
     dp->substeps = cfg_int(cfg, "dem", "substeps");
     dp->rest_after = cfg_double(cfg, "dem", "rest_after");
     /* a fluid (resolved or pore network) sets the step; the DEM sub-cycles in it */
-    dp->with_fluid = sim_fluid_enabled(cfg) || cfg_has_section(cfg, "porenet");
+    const fluid_model_t model = fluid_model_of(cfg);
+    dp->with_fluid = model == FLUID_MODEL_RESOLVED || model == FLUID_MODEL_PORENET;
     if (dem_count(dp->d) == 0) cfg_fail(cfg, "particles", "source", "the scene has no particles");
     sim_part_t part = {
         .name = "dem",

@@ -24,6 +24,7 @@ typedef struct {
     int stepped;          /* a step was taken in this run */
     io_snapshots_t *snaps;
     int snap_first;       /* index of the first snapshot of this run */
+    int viscous_reports;  /* viscous = auto: log lines about its choice */
 } fluid_part_t;
 
 static const char *const fluid_cols[] = {"cfl", "kinetic_energy", "div_max", "poisson_residual",
@@ -33,13 +34,33 @@ static int ncomp(const fluid_part_t *fp) { return fp->g->dim == 3 ? 3 : 2; }
 
 static double part_stable_dt(void *ctx) { return fluid_stable_dt(((fluid_part_t *)ctx)->f); }
 
+/* viscous = auto: the choice in the log, at the first step of the run and
+ * when it changes (the first few changes; summary.json counts the steps) */
+static void report_viscous(fluid_part_t *fp, int was_implicit, double dt)
+{
+    const fluid_t *f = fp->f;
+    if (f->prm.implicit_viscous != FLUID_VISCOUS_AUTO || (fp->stepped && was_implicit == f->implicit_step)) return;
+    if (fp->viscous_reports++ == 6) {
+        msg("fluid: viscous = auto: further changes of the viscous term are not reported (summary.json: "
+            "fluid.implicit_steps)\n");
+        return;
+    }
+    if (fp->viscous_reports > 6) return;
+    msg("fluid: viscous = auto: %s viscous term from step %ld (dt = %.4g: %.3g times the explicit limit %.4g, "
+        "Fourier number dt nu max sum 1/dx^2 = %.3g)\n",
+        f->implicit_step ? "implicit (Crank-Nicolson)" : "explicit", f->step, dt, dt / f->dt_viscous, f->dt_viscous,
+        dt / f->dt_viscous * f->prm.fourier);
+}
+
 static void part_advance(void *ctx, double dt)
 {
     fluid_part_t *fp = ctx;
     fp->ke_prev = fp->ke_now;
     const double us = 0.1 * fp->f->prm.cfl * fp->hmin / dt;
     fp->ke_still = 0.5 * fp->volume * us * us;
+    const int was_implicit = fp->f->implicit_step;
     fluid_step(fp->f, dt);
+    report_viscous(fp, was_implicit, dt);
     fp->ke_now = fp->f->diag.ke;
     fp->stepped = 1;
 }
@@ -171,6 +192,7 @@ static void part_checkpoint_write(void *ctx, hid_t grp)
     io_h5_attr_double(grp, "time", f->time);
     io_h5_attr_long(grp, "step", f->step);
     io_h5_attr_long(grp, "snapshots", fp->snaps ? io_snapshots_count(fp->snaps) : fp->snap_first);
+    io_h5_attr_long(grp, "implicit_steps", f->implicit_steps);
     io_h5_attr_string(grp, "layout", "interior of each staggered field, [nx][ny][nz], k fastest; "
                                      "u(i) on the high x face of cell i (CaNS convention)");
     for (int c = 0; c < 4; c++) {
@@ -249,6 +271,7 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
     if (io_h5_get_attr_double(grp, "time", &f->time) || io_h5_get_attr_long(grp, "step", &f->step))
         die("%s: /fluid has no time or step attribute", path);
     if (io_h5_get_attr_long(grp, "snapshots", &snaps) == 0) fp->snap_first = (int)snaps;
+    if (io_h5_get_attr_long(grp, "implicit_steps", &f->implicit_steps)) f->implicit_steps = 0;
     fluid_apply_bc(f);
     fill_pressure_ghosts(fp->g, f->p);
     fp->ke_now = fluid_kinetic_energy(f);
@@ -275,6 +298,10 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
     io_summary_double(y, KEY("div_max"), fp->stepped ? d->div_max : fp->div_init);
     io_summary_double(y, KEY("poisson_residual"), d->res_poisson);
     io_summary_long(y, KEY("poisson_iterations"), d->it_poisson);
+    static const char *visc[3] = {"explicit", "implicit", "auto"};
+    io_summary_string(y, KEY("viscous"), visc[fp->f->prm.implicit_viscous]);
+    io_summary_long(y, KEY("implicit_steps"), fp->f->implicit_steps);
+    if (isfinite(fp->f->dt_viscous)) io_summary_double(y, KEY("explicit_viscous_limit"), fp->f->dt_viscous);
 #undef KEY
 }
 

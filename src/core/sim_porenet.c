@@ -36,6 +36,9 @@ typedef struct {
     double *xp, *rp;    /* the fixed packing read from porenet.packing */
     double q[6];
     double kappa[3];
+    int snapshots;      /* write the network at the run's snapshot times */
+    void (*before_start)(void *ctx); /* called once before the first solve (sim_porenet_before_start) */
+    void *before_ctx;
 } porenet_part_t;
 
 static const char *const pn_cols[] = {"porenet_q_in_max", "porenet_q_out_max", "porenet_p_max", "porenet_pores"};
@@ -129,12 +132,21 @@ static void solve_now(porenet_part_t *pp, double dt)
     after_solve(pp);
 }
 
+/* Arithmetic mean diameter of the spheres (κ/d²). */
+static double mean_diameter(const porenet_part_t *pp)
+{
+    double s = 0;
+    for (int i = 0; i < pp->n; i++) s += 2 * pp->r[i];
+    return pp->n ? s / pp->n : NAN;
+}
+
 /* The first solve, once the particles exist (the DEM prepares its packing
  * lazily, at the first step of a new run). */
 static void ensure_started(porenet_part_t *pp)
 {
     if (pp->started) return;
     pp->started = 1;
+    if (pp->before_start) pp->before_start(pp->before_ctx);
     if (pp->with_dem) pp->d = sim_dem_engine(pp->sim);
     solve_now(pp, 0.0);
     double re, sr, por;
@@ -147,8 +159,12 @@ static void ensure_started(porenet_part_t *pp)
     if (pp->with_dem)
         msg("porenet: coupled with the DEM, viscous step limit %.4g s (DEM step %.4g s)\n", pn_coupled_dt(&pp->m, pp->d),
             dem_dt(pp->d));
+    const double d = mean_diameter(pp);
     for (int a = 0; a < 3; a++)
-        if (isfinite(pp->kappa[a])) msg("porenet: permeability along %c = %.6e m^2\n", 'x' + a, pp->kappa[a]);
+        if (isfinite(pp->kappa[a]))
+            msg("porenet: permeability along %c = %.6e L^2 (L the length unit of the case: m^2 for lengths in m), "
+                "kappa/d^2 = %.6e (d = %.6g, the mean diameter)\n",
+                'x' + a, pp->kappa[a], pp->kappa[a] / (d * d), d);
 }
 
 static double part_stable_dt(void *ctx)
@@ -199,7 +215,33 @@ static void part_write_fields(void *ctx, double time, long step)
     (void)step;
     porenet_part_t *pp = ctx;
     ensure_started(pp);
-    pn_write_snapshot(&pp->m, pp->x, pp->sim->out.dir, time);
+    if (pp->snapshots) pn_write_snapshot(&pp->m, pp->x, pp->sim->out.dir, time);
+}
+
+static void part_checkpoint_write(void *ctx, hid_t g)
+{
+    porenet_part_t *pp = ctx;
+    ensure_started(pp);
+    pn_model_state_write(&pp->m, g);
+}
+
+/* The state of the run that wrote the checkpoint (state.c): the
+ * triangulation of its last rebuild, the strain accumulated since, the
+ * previous positions and volumes, the pressures, the forces the DEM holds in
+ * its next step and the snapshot index. */
+static void part_checkpoint_read(void *ctx, hid_t g, const char *path)
+{
+    porenet_part_t *pp = ctx;
+    pp->started = 1;
+    pp->d = sim_dem_engine(pp->sim);
+    pn_model_gather(&pp->m, pp->d);
+    if (pn_model_state_read(&pp->m, g, dem_count(pp->d), pp->m.rid)) die("%s: porenet: %s", path, pp->m.err);
+    if (!pp->m.built) die("%s: porenet: the checkpoint holds no network", path);
+    pn_model_apply_forces(&pp->m, pp->d, pp->g);
+    pp->n = pp->m.n;
+    pp->x = pp->m.xid;
+    pp->r = pp->m.rid;
+    after_solve(pp);
 }
 
 static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
@@ -215,8 +257,13 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
     io_summary_long(y, KEY("%s.throats", prefix), m->net.nthroat);
     io_summary_long(y, KEY("%s.triangulations", prefix), m->n_retri);
     io_summary_long(y, KEY("%s.coupled_steps", prefix), m->n_steps);
+    const double d = mean_diameter(pp);
+    io_summary_double(y, KEY("%s.mean_diameter", prefix), d);
     for (int a = 0; a < 3; a++)
-        if (isfinite(pp->kappa[a])) io_summary_double(y, KEY("%s.permeability_%c", prefix, 'x' + a), pp->kappa[a]);
+        if (isfinite(pp->kappa[a])) {
+            io_summary_double(y, KEY("%s.permeability_%c", prefix, 'x' + a), pp->kappa[a]);
+            io_summary_double(y, KEY("%s.permeability_over_d2_%c", prefix, 'x' + a), pp->kappa[a] / (d * d));
+        }
     for (int f = 0; f < 6; f++)
         if (!m->dom.periodic[f / 2]) io_summary_double(y, KEY("%s.flux_in.%s", prefix, fn[f]), pp->q[f]);
     double F[6][3], fs[3] = {0, 0, 0};
@@ -259,6 +306,8 @@ void sim_add_porenet(sim_t *s, cfg_t *cfg)
     pp->sim = s;
     pn_model_from_config(cfg, &pp->m);
     pp->with_dem = cfg_has_section(cfg, "particles");
+    const int snaps = cfg_enum(cfg, "porenet", "snapshots");
+    pp->snapshots = snaps == 1 || (snaps == 0 && pp->with_dem);
     if (pp->with_dem) {
         if (cfg_has(cfg, "porenet", "packing"))
             cfg_fail(cfg, "porenet", "packing", "the scene has DEM particles ([particles]): give one or the other");
@@ -282,8 +331,32 @@ void sim_add_porenet(sim_t *s, cfg_t *cfg)
         .diagnostics = part_diagnostics,
         .diverged = part_diverged,
         .write_fields = part_write_fields,
+        /* a fixed packing is solved once: nothing to restart from */
+        .checkpoint_write = pp->with_dem ? part_checkpoint_write : NULL,
+        .checkpoint_read = pp->with_dem ? part_checkpoint_read : NULL,
         .summary = part_summary,
         .destroy = part_destroy,
     };
     sim_add_part(s, &part);
+}
+
+static porenet_part_t *find_part(sim_t *s)
+{
+    for (int p = 0; p < s->npart; p++)
+        if (!strcmp(s->part[p].name, "porenet")) return s->part[p].ctx;
+    return NULL;
+}
+
+pn_model_t *sim_porenet_model(sim_t *s)
+{
+    porenet_part_t *pp = find_part(s);
+    return pp ? &pp->m : NULL;
+}
+
+void sim_porenet_before_start(sim_t *s, void (*fn)(void *ctx), void *ctx)
+{
+    porenet_part_t *pp = find_part(s);
+    if (!pp) die("sim_porenet_before_start: the scene has no pore network");
+    pp->before_start = fn;
+    pp->before_ctx = ctx;
 }

@@ -148,6 +148,7 @@ void dem_free(dem_t *d)
     free(d->snap_t);
     free(d->snap_n);
     free(d->snap_index);
+    dem_drag_free(d);
     free(d);
 }
 
@@ -294,7 +295,8 @@ static inline double local_damping(double F, double v, double alpha)
  * step fused in); returns max |v|² over the mobile particles. */
 static double kick_drift(dem_t *d)
 {
-    const double dt = d->lub.on ? 0.0 : d->dt, h = 0.5 * d->dt; /* lubrication: drift after its impulses */
+    const int impulses = d->lub.on || d->drag.on;
+    const double dt = impulses ? 0.0 : d->dt, h = 0.5 * d->dt; /* lubrication, drag: drift after their impulses */
     const double gx = d->gravity[0], gy = d->gravity[1], gz = d->gravity[2];
     const double kick = d->pending_kick ? 2.0 : 1.0; /* closing kick of the last step + opening kick */
     double *restrict x = d->x, *restrict v = d->v, *restrict w = d->w, *restrict dv = d->dv, *restrict dw = d->dw;
@@ -362,9 +364,11 @@ static double kick_drift(dem_t *d)
         }
     }
     d->pending_kick = 1;
-    if (d->lub.on) {
-        /* the lubrication impulses of this drift (implicit in the gap it produces), then the drift */
-        dem_lubrication_impulses(d, d->dt);
+    if (impulses) {
+        /* the drag (implicit in the velocity) and the lubrication impulses of
+         * this drift (implicit in the gap it produces), then the drift */
+        if (d->drag.on) dem_drag_impulses(d, d->dt);
+        if (d->lub.on) dem_lubrication_impulses(d, d->dt);
         vmax2 = 0.0;
         for (int i = 0; i < n; i++) {
             if (fixed[i]) continue;

@@ -623,6 +623,7 @@ dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
 #endif
     d->hist_update = 1;
     dem_lubrication_config(d, cfg);
+    dem_drag_config(d, cfg);
     config_walls(d, cfg);
     const int src = cfg_enum(cfg, "particles", "source");
     if (src == 2 && cfg_enum(cfg, "bed", "type") != 0)

@@ -276,6 +276,11 @@ void dem_checkpoint_write_loc(dem_t *d, hid_t f)
     write_ds(d, f, "contact_xi", H5T_NATIVE_DOUBLE, pxi, m, 3);
     free(pid);
     free(pxi);
+    /* the drag's local solid fractions, held between their updates (by id) */
+    if (d->drag.on && d->drag.phi_step >= 0) {
+        write_attr_l(f, "drag_fraction_step", d->drag.phi_step);
+        write_ds(d, f, "drag_fraction", H5T_NATIVE_DOUBLE, d->drag.phi, d->drag.nphi, 1);
+    }
     /* walls: state and springs */
     for (int w = 0; w < d->nwall; w++) {
         dem_wall_t *W = &d->wall[w];
@@ -287,6 +292,11 @@ void dem_checkpoint_write_loc(dem_t *d, hid_t f)
         const double act = W->active;
         write_attr_d(g, "active", &act, 1);
         write_attr_d(g, "velocity", W->vel, 3); /* a load-controlled wall's changes */
+        /* a load-controlled wall: its load, mass and the particles' force of the last step (its next
+         * leap-frog step reads it) */
+        const double load[2] = {W->push, W->mass};
+        write_attr_d(g, "load_mass", load, 2);
+        write_attr_d(g, "force", W->force, 3);
         long nw = 0;
         for (int e = 0; e < W->nlist; e++) nw += W->on[e];
         long *wid = malloc(((size_t)nw + 1) * sizeof(long));
@@ -327,6 +337,25 @@ static int cmp_long(const void *a, const void *b)
 {
     const long x = *(const long *)a, y = *(const long *)b;
     return (x > y) - (x < y);
+}
+
+/* The motion of a wall: its point, whether it is active, and for a
+ * load-controlled wall its velocity, load, mass and the particles' force of
+ * the last step (its next leap-frog step reads it). */
+static void read_wall_motion(hid_t g, dem_wall_t *W)
+{
+    double act = 1;
+    read_attr_d(g, "point", W->p);
+    read_attr_d(g, "active", &act);
+    W->active = act != 0;
+    if (H5Aexists(g, "velocity") > 0) read_attr_d(g, "velocity", W->vel);
+    if (H5Aexists(g, "load_mass") > 0 && H5Aexists(g, "force") > 0) {
+        double load[2];
+        read_attr_d(g, "load_mass", load);
+        read_attr_d(g, "force", W->force);
+        W->push = load[0];
+        W->mass = load[1];
+    }
 }
 
 /* The neighbour and wall lists saved by dem_checkpoint_write_loc, if the
@@ -376,11 +405,8 @@ static int read_exact_lists(dem_t *d, hid_t f)
         char name[64];
         snprintf(name, sizeof name, "wall_%s", W->name);
         hid_t g = H5Gopen2(f, name, H5P_DEFAULT);
-        double act = 1;
-        read_attr_d(g, "point", W->p);
-        read_attr_d(g, "active", &act);
+        read_wall_motion(g, W);
         read_attr_d(g, "list_moved", &W->moved);
-        W->active = act != 0;
         const long nl = ds_length(g, "list_idx");
         if (nl > W->cap) {
             free(W->idx);
@@ -500,11 +526,7 @@ void dem_checkpoint_read_loc(dem_t *d, hid_t f, const char *path)
         snprintf(name, sizeof name, "wall_%s", W->name);
         if (!has_ds(f, name)) continue;
         hid_t g = H5Gopen2(f, name, H5P_DEFAULT);
-        double act = 1;
-        read_attr_d(g, "point", W->p);
-        read_attr_d(g, "active", &act);
-        if (H5Aexists(g, "velocity") > 0) read_attr_d(g, "velocity", W->vel);
-        W->active = act != 0;
+        read_wall_motion(g, W);
         const long nw = ds_length(g, "ids");
         long *wid = malloc(((size_t)nw + 1) * sizeof(long));
         double *wxi = malloc((3 * (size_t)nw + 1) * sizeof(double));
@@ -553,6 +575,21 @@ forces:
     free(rho);
     free(ids);
     free(fx);
+    if (d->drag.on && has_ds(f, "drag_fraction")) {
+        /* by particle id: as many as the writer's ids (this run's next_id may be larger) */
+        hid_t a = H5Aopen(f, "drag_fraction_step", H5P_DEFAULT);
+        const long nphi = ds_length(f, "drag_fraction"), nall = nphi > d->next_id ? nphi : d->next_id;
+        if (a >= 0) {
+            d->drag.phi = realloc(d->drag.phi, ((size_t)nall + 1) * sizeof *d->drag.phi);
+            d->drag.fd = realloc(d->drag.fd, 3 * ((size_t)nall + 1) * sizeof *d->drag.fd);
+            memset(d->drag.phi, 0, ((size_t)nall + 1) * sizeof *d->drag.phi);
+            memset(d->drag.fd, 0, 3 * ((size_t)nall + 1) * sizeof *d->drag.fd);
+            d->drag.nphi = nall;
+            read_ds(f, "drag_fraction", H5T_NATIVE_DOUBLE, d->drag.phi);
+            H5Aread(a, H5T_NATIVE_LONG, &d->drag.phi_step);
+            H5Aclose(a);
+        }
+    }
     d->ready = restored;
     d->pending_kick = 0;
     msg("dem: read %ld particles from %s (t = %g s)\n", n, path, t);

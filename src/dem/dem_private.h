@@ -65,6 +65,23 @@ typedef struct {
     double reach;        /* largest cut-off among the particles (m): margin of the lists */
 } dem_lub_t;
 
+/* The drag closure of the reduced fluid model `drag` (drag.c). */
+typedef struct {
+    int on;
+    int closure;         /* 0 stokes, 1 richardson_zaki */
+    double n_rz;         /* Richardson–Zaki exponent */
+    double mu, rho_f;    /* viscosity, fluid density (buoyancy) */
+    double uf[3];        /* prescribed mean fluid velocity */
+    double radius_rel;   /* sampling radius of φ in mean diameters */
+    double R;            /* sampling radius (m), set at the first update */
+    int every;           /* DEM steps between updates of φ */
+    int rotation;        /* Stokes torque */
+    double *phi;         /* local solid fraction, by particle id */
+    double *fd;          /* drag force of the last step, by particle id (3 per id) */
+    long nphi;           /* ids covered by phi and fd */
+    long phi_step;       /* step of the last update of phi (−1: none) */
+} dem_drag_t;
+
 /* Called after every DEM step (dem_set_step_observer). */
 typedef void (*dem_step_observer_t)(dem_t *d, void *ctx);
 
@@ -134,8 +151,9 @@ struct dem {
     int nwall;
     dem_wall_t wall[DEM_MAX_WALLS];
 
-    /* lubrication */
+    /* lubrication, drag */
     dem_lub_t lub;
+    dem_drag_t drag;
     dem_step_observer_t observer;
     void *observer_ctx;
 
@@ -248,6 +266,14 @@ void dem_lubrication_impulses(dem_t *d, double dt);
 double dem_lub_approach_time(const dem_t *d, double R, double reff, double m, double gap0, double u0, double a);
 /* Largest gap at which a particle of radius rmax is lubricated (the margin the lists need). */
 double dem_lub_reach(const dem_lub_t *L, double rmax);
+
+/* ---- drag closure (drag.c) ---- */
+/* Read [drag] when the fluid model is drag (off otherwise). */
+void dem_drag_config(dem_t *d, cfg_t *cfg);
+void dem_drag_free(dem_t *d);
+/* The drag and buoyancy of the coming drift of length dt on the half-step
+ * velocities (implicit), after updating the local solid fractions if due. */
+void dem_drag_impulses(dem_t *d, double dt);
 
 /* ---- pair and wall geometry for the passes outside the force kernel ---- */
 /* Unit normal n from particle i to the partner of its list entry e (the

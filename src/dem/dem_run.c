@@ -72,6 +72,10 @@ int dem_prepare_packing(dem_t *d, cfg_t *cfg, const char *outdir)
         d->wall[w].remove_time = INFINITY;
     }
     dem_set_gravity(d, g);
+    /* a dry preparation: no lubrication (its pairs are most of the cost of
+     * settling a dense bed, and it only slows the settling down), no drag */
+    const int lub_on = d->lub.on, drag_on = d->drag.on;
+    d->lub.on = d->drag.on = 0;
     static const char *vname[] = {"dense (frictionless)", "loose (high friction)", "with the run's contact law"};
     msg("dem: settling the packing %s, gravity (%g, %g, %g)\n", vname[variant], g[0], g[1], g[2]);
     const double t0 = d->time, w0 = wtime();
@@ -96,6 +100,8 @@ int dem_prepare_packing(dem_t *d, cfg_t *cfg, const char *outdir)
     msg("dem: settling %s after %.4g s (%.1f s wall): kinetic energy %.3g m g d per particle\n",
         rc == 0 ? "at rest" : "stopped", d->time - t0, wtime() - w0, e);
     if (rc == 1) warn("dem: packing not at rest after packing.max_time = %g s\n", tmax);
+    d->lub.on = lub_on;
+    d->drag.on = drag_on;
     d->cp.mu = mu;
     d->cp.mu_wall = mu_w;
     for (int w = 0; w < d->nwall; w++) d->wall[w].remove_time = trem[w];

@@ -49,7 +49,7 @@
 #include <string.h>
 
 #include "dem_private.h"
-#include "fluid.h"
+#include "fluid_model.h"
 #include "util.h"
 
 typedef struct {
@@ -418,7 +418,8 @@ static const cfg_key_t lub_keys[] = {
      "-6 pi eta_f R^2 u_n / eta_e: the contact damping of eq. 3.26)"},
     {"lubrication", "walls", CFG_BOOL, "true", 1, 0, NULL, "also between a particle and a wall"},
     {"lubrication", "viscosity", CFG_DOUBLE, "-1", -1, 1e12, NULL,
-     "dynamic viscosity eta_f (Pa s); -1: rho nu of the [fluid] section"},
+     "dynamic viscosity eta_f (Pa s); -1: that of the scene's fluid (rho nu of [fluid], or the viscosity of "
+     "[drag] or [porenet])"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
 };
 
@@ -428,7 +429,7 @@ void dem_lubrication_config(dem_t *d, cfg_t *cfg)
 {
     dem_lub_t *L = &d->lub;
     memset(L, 0, sizeof *L);
-    L->model = cfg_enum(cfg, "lubrication", "model");
+    L->model = fluid_model_lubrication(cfg) ? cfg_enum(cfg, "lubrication", "model") : LUB_NONE;
     L->on = L->model != LUB_NONE;
     if (!L->on) return;
     L->roughness = cfg_double(cfg, "lubrication", "roughness");
@@ -446,10 +447,11 @@ void dem_lubrication_config(dem_t *d, cfg_t *cfg)
     }
     L->viscosity = cfg_double(cfg, "lubrication", "viscosity");
     if (L->viscosity < 0) {
-        if (!cfg_has_section(cfg, "fluid"))
+        L->viscosity = fluid_model_viscosity(cfg);
+        if (L->viscosity < 0)
             cfg_fail(cfg, "lubrication", "viscosity",
-                     "needed: the scene has no [fluid] section to take rho nu from (a dry DEM with lubrication)");
-        L->viscosity = cfg_double(cfg, "fluid", "rho") * fluid_nu_from_config(cfg);
+                     "needed: the scene gives no fluid viscosity to take it from ([fluid] rho nu or mu, [drag] or "
+                     "[porenet] viscosity)");
     }
     if (!(L->viscosity > 0)) cfg_fail(cfg, "lubrication", "viscosity", "must be positive with lubrication");
 }

@@ -17,9 +17,15 @@ static const cfg_key_t fluid_keys[] = {
     {"fluid", "body_force", CFG_VEC3, "0 0 0", -1e300, 1e300, NULL,
      "uniform body acceleration (e.g. a mean pressure gradient −(dP/dx)/ρ); NOT gravity: the pressure is "
      "relative to hydrostatic"},
-    {"fluid", "viscous", CFG_ENUM, "explicit", 1, 0, "explicit|implicit",
-     "viscous term: explicit in the RK3 stages, or Crank–Nicolson per stage (Helmholtz solves, same method "
-     "as [poisson])"},
+    {"fluid", "viscous", CFG_ENUM, "auto", 1, 0, "explicit|implicit|auto",
+     "viscous term: explicit in the RK3 stages, Crank–Nicolson per stage (Helmholtz solves, same method "
+     "as [poisson]), or auto: per step, explicit where its stability limit (fourier) allows the step the other "
+     "limits set, implicit where they allow more than viscous_auto_ratio times it (reported in the log and "
+     "summary.json)"},
+    {"fluid", "viscous_auto_ratio", CFG_DOUBLE, "2", 1, 1e6, NULL,
+     "viscous = auto: an implicit step is taken when the other limits allow a step more than this many times "
+     "the explicit viscous limit (below, the explicit limit sets the step: an implicit step costs 1.5-3 explicit "
+     "ones)"},
     {"fluid", "wall_ghost", CFG_ENUM, "linear", 1, 0, "linear|quadratic",
      "ghost of the wall-tangential velocity at a no-slip wall in the viscous term: linear 2U − u₀ (exact for "
      "Couette flow), or quadratic through U, u₀, u₁ (exact for plane and pipe Poiseuille flow on a uniform grid; "
@@ -54,7 +60,9 @@ void fluid_params_from_config(cfg_t *cfg, const grid_t *g, fluid_params_t *prm)
     prm->nu = fluid_nu_from_config(cfg);
     prm->rho = cfg_double(cfg, "fluid", "rho");
     cfg_vec3(cfg, "fluid", "body_force", prm->body_force);
-    prm->implicit_viscous = cfg_enum(cfg, "fluid", "viscous") == 1;
+    static const int viscous[3] = {FLUID_VISCOUS_EXPLICIT, FLUID_VISCOUS_IMPLICIT, FLUID_VISCOUS_AUTO};
+    prm->implicit_viscous = viscous[cfg_enum(cfg, "fluid", "viscous")];
+    prm->viscous_auto_ratio = cfg_double(cfg, "fluid", "viscous_auto_ratio");
     prm->wall_ghost = cfg_enum(cfg, "fluid", "wall_ghost") == 1 ? WALL_GHOST_QUADRATIC : WALL_GHOST_LINEAR;
     prm->cfl = cfg_double(cfg, "fluid", "cfl");
     prm->fourier = cfg_double(cfg, "fluid", "fourier");
@@ -81,7 +89,7 @@ fluid_t *fluid_create(grid_t *g, const fluid_params_t *prm)
 {
     /* ν = 0 (inviscid) is allowed through the API for the energy tests; the
      * case file requires ν > 0 */
-    if (!(prm->nu >= 0) || (prm->implicit_viscous && !(prm->nu > 0)))
+    if (!(prm->nu >= 0) || (prm->implicit_viscous == FLUID_VISCOUS_IMPLICIT && !(prm->nu > 0)))
         die("fluid_create: nu must be > 0 (got %g)", prm->nu);
     fluid_t *f = xcalloc(1, sizeof *f);
     fluid_priv_t *q = xcalloc(1, sizeof *q);
@@ -96,8 +104,8 @@ fluid_t *fluid_create(grid_t *g, const fluid_params_t *prm)
         f->u[c] = field_alloc(g);
         q->h[c] = field_alloc(g);
         q->spare[c] = field_alloc(g);
-        q->pv[c] = prm->implicit_viscous ? poisson_create(g, (var_loc_t)c, &prm->poisson)
-                                         : poisson_create_operator(g, (var_loc_t)c);
+        q->pv[c] = prm->implicit_viscous == FLUID_VISCOUS_IMPLICIT ? poisson_create(g, (var_loc_t)c, &prm->poisson)
+                                                                   : poisson_create_operator(g, (var_loc_t)c);
     }
     f->p = field_alloc(g);
     q->work = field_alloc(g);
@@ -114,6 +122,10 @@ fluid_t *fluid_create(grid_t *g, const fluid_params_t *prm)
         q->ac[i] = g->geom == GEOM_AXI ? g->xc[i] : 1.0;
     }
     fluid_viscous_setup(f);
+    f->dt_viscous = fluid_viscous_limit(f);
+    f->implicit_step = prm->implicit_viscous == FLUID_VISCOUS_IMPLICIT;
+    if (prm->implicit_viscous == FLUID_VISCOUS_AUTO && fluid_auto_may_be_implicit(f))
+        for (int c = 0; c < nc; c++) poisson_add_solver(q->pv[c], &prm->poisson);
     fluid_apply_bc(f);
     return f;
 }

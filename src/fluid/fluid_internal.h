@@ -94,6 +94,12 @@ void fluid_laplacian_add(const fluid_t *f, int c, const double *u, double scale,
 void fluid_wall_terms_add(const fluid_t *f, int c, double scale, double *out);
 void fluid_wall_ghost_add(const fluid_t *f, int c, const double *u, double scale, double *out);
 void fluid_viscous_setup(fluid_t *f);
+/* The explicit viscous step limit (fourier target; INFINITY without viscosity; timestep.c). */
+double fluid_viscous_limit(const fluid_t *f);
+/* viscous = auto: a step of this run can be implicit (the Helmholtz solvers are needed). */
+int fluid_auto_may_be_implicit(const fluid_t *f);
+/* The step dt is taken with the Crank–Nicolson viscous term. */
+int fluid_step_is_implicit(const fluid_t *f, double dt);
 /* bc.c */
 void fluid_fill_pressure_ghosts(const fluid_t *f, double *p);
 /* fluid_apply_bc in parts: the edge planes' ghosts, then an inner plane's */

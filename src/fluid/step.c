@@ -138,10 +138,10 @@ static void project_stage(fluid_t *f, double dt_stage, int update_pressure, doub
     fluid_priv_t *q = fluid_priv(f);
     double *phi = solve_correction(f, dt_stage, div_ready, 0);
     /* u −= α Δt G φ [and p += φ with explicit viscous terms], one sweep */
-    int fuse_p = update_pressure && !f->prm.implicit_viscous;
+    int fuse_p = update_pressure && !f->implicit_step;
     correct_velocity(f, phi, dt_stage, fuse_p, stats, div_cfl);
     if (update_pressure) {
-        if (f->prm.implicit_viscous) {
+        if (f->implicit_step) {
             /* p += φ − (α Δt ν/2) L φ: the pressure consistent with the
              * Crank–Nicolson predictor (Brown, Cortez & Minion 2001) */
             const poisson_t *pp = q->pp;
@@ -344,7 +344,8 @@ void fluid_step(fluid_t *f, double dt)
     fluid_priv_t *q = fluid_priv(f);
     int nc = fluid_ncomp(g);
     double stats[2] = {0.0, 0.0}, div_cfl[2] = {0.0, 0.0};
-    int is3d = g->dim == 3, impl = f->prm.implicit_viscous;
+    f->implicit_step = fluid_step_is_implicit(f, dt);
+    int is3d = g->dim == 3, impl = f->implicit_step;
     /* Decided after the stage-begin hook of stage 0 (its promises,
      * f->hook_flags, hold for the step):
      * - plane hook inside the predictor sweep (theory §1, step 1.1b) when
@@ -438,6 +439,7 @@ void fluid_step(fluid_t *f, double dt)
     }
     f->time += dt;
     f->step++;
+    f->implicit_steps += impl;
     f->diag.dt = dt;
     fluid_update_diagnostics(f, stats, is3d ? div_cfl : NULL);
 }

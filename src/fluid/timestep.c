@@ -71,6 +71,30 @@ static double viscous_rate(const fluid_t *f)
     return 0.25 * r;
 }
 
+double fluid_viscous_limit(const fluid_t *f)
+{
+    const fluid_params_t *prm = &f->prm;
+    return prm->nu > 0 ? prm->fourier / (prm->nu * viscous_rate(f)) : INFINITY;
+}
+
+/* viscous = auto: can a step be implicit?  A fixed step above the explicit
+ * limit, or an adaptive one whose dt_max (if any) allows more than the
+ * ratio times it (the Helmholtz solvers are made only then). */
+int fluid_auto_may_be_implicit(const fluid_t *f)
+{
+    const fluid_params_t *prm = &f->prm;
+    if (!isfinite(f->dt_viscous)) return 0;
+    if (prm->dt_fixed > 0) return prm->dt_fixed > f->dt_viscous;
+    return !(prm->dt_max > 0) || prm->dt_max > prm->viscous_auto_ratio * f->dt_viscous;
+}
+
+int fluid_step_is_implicit(const fluid_t *f, double dt)
+{
+    const int mode = f->prm.implicit_viscous;
+    /* a last step stretched by round-off to land on t_end (sim.c) stays explicit */
+    return mode == FLUID_VISCOUS_IMPLICIT || (mode == FLUID_VISCOUS_AUTO && dt > f->dt_viscous * (1 + 1e-6));
+}
+
 double fluid_stable_dt(const fluid_t *f)
 {
     const fluid_params_t *prm = &f->prm;
@@ -91,8 +115,14 @@ double fluid_stable_dt(const fluid_t *f)
     double rate = fmax(fluid_convective_rate(f), fmax(uw / dmin, sqrt(fb / dmin)));
     double dt = rate > 0 ? prm->cfl / rate : DBL_MAX;
     double dt_visc = prm->nu > 0 ? prm->fourier / (prm->nu * viscous_rate(f)) : DBL_MAX;
-    if (!prm->implicit_viscous) dt = fmin(dt, dt_visc);
     if (prm->dt_max > 0) dt = fmin(dt, prm->dt_max);
+    /* explicit: the viscous limit too; auto: unless the other limits allow
+     * more than the ratio times it and the Helmholtz solvers exist (the step
+     * is then implicit, fluid_step_is_implicit) */
+    const int mode = prm->implicit_viscous;
+    if (mode == FLUID_VISCOUS_EXPLICIT ||
+        (mode == FLUID_VISCOUS_AUTO && !(dt > prm->viscous_auto_ratio * dt_visc && fluid_auto_may_be_implicit(f))))
+        dt = fmin(dt, dt_visc);
     /* implicit, at rest, unforced and without dt_max: nothing limits the step;
      * take the explicit viscous one */
     if (dt == DBL_MAX) dt = dt_visc;

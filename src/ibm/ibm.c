@@ -39,7 +39,7 @@ static const cfg_key_t ibm_keys[] = {
      "over the jump counted in the next force (step: one rebuild per step instead of three, see "
      "docs/theory.md)"},
     {"ibm", "cn_forcing", CFG_ENUM, "after_solve", 1, 0, "after_solve|predictor",
-     "with [fluid] viscous = implicit: the forcing is computed from the Crank-Nicolson solution and applied "
+     "with the Crank-Nicolson viscous term ([fluid] viscous = implicit, or auto on its implicit steps): the forcing is computed from the Crank-Nicolson solution and applied "
      "after the solve (after_solve), or from the explicit predictor with the whole viscous term and applied as a "
      "source term of the implicit solve (predictor: stable and accurate at large Δt ν/Δx², see docs/theory.md "
      "§4.6); no effect with the explicit viscous term"},

@@ -128,6 +128,13 @@ poisson_t *poisson_create_operator(const grid_t *g, var_loc_t loc)
 poisson_t *poisson_create(const grid_t *g, var_loc_t loc, const poisson_opts_t *opt)
 {
     poisson_t *p = poisson_create_operator(g, loc);
+    poisson_add_solver(p, opt);
+    return p;
+}
+
+void poisson_add_solver(poisson_t *p, const poisson_opts_t *opt)
+{
+    if (p->impl) return;
     if (opt)
         p->opt = *opt;
     else {
@@ -138,7 +145,6 @@ poisson_t *poisson_create(const grid_t *g, var_loc_t loc, const poisson_opts_t *
     }
     p->backend = p->opt.method == POISSON_FFT ? &poisson_backend_fft : &poisson_backend_mg;
     p->impl = p->backend->create(p);
-    return p;
 }
 
 void poisson_free(poisson_t *p)

@@ -7,7 +7,7 @@
 #include "dem.h"
 #include "porenet.h"
 
-int pn_model_couple_dem(pn_model_t *m, dem_t *d, const double g[3], double dt)
+void pn_model_gather(pn_model_t *m, const dem_t *d)
 {
     const int n = dem_count(d);
     const double *x = dem_positions(d), *r = dem_radii(d);
@@ -23,7 +23,21 @@ int pn_model_couple_dem(pn_model_t *m, dem_t *d, const double g[3], double dt)
         for (int a = 0; a < 3; a++) m->xid[3 * k + a] = x[3 * i + a];
         m->rid[k] = r[i];
     }
-    if (pn_model_step(m, n, m->xid, m->rid, dt)) return -1;
+}
+
+int pn_model_couple_dem(pn_model_t *m, dem_t *d, const double g[3], double dt)
+{
+    pn_model_gather(m, d);
+    if (pn_model_step(m, dem_count(d), m->xid, m->rid, dt)) return -1;
+    pn_model_apply_forces(m, d, g);
+    return 0;
+}
+
+void pn_model_apply_forces(const pn_model_t *m, dem_t *d, const double g[3])
+{
+    const int n = dem_count(d);
+    const double *r = dem_radii(d);
+    const long *id = dem_ids(d);
     double *fe = dem_ext_force(d), *te = dem_ext_torque(d);
     for (int i = 0; i < n; i++) {
         const long k = id[i];
@@ -34,7 +48,6 @@ int pn_model_couple_dem(pn_model_t *m, dem_t *d, const double g[3], double dt)
             te[3 * i + a] = 0;
         }
     }
-    return 0;
 }
 
 double pn_coupled_dt(const pn_model_t *m, const dem_t *d)

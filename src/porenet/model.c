@@ -19,6 +19,7 @@ void pn_model_free(pn_model_t *m)
     free(m->vol_prev);
     free(m->dvdt);
     free(m->x_prev);
+    free(m->x_tri);
     free(m->f);
     free(m->fp);
     free(m->fv);
@@ -31,7 +32,7 @@ void pn_model_free(pn_model_t *m)
     m->snap_counts = NULL;
     m->nsnap = 0;
     m->sol = NULL;
-    m->p = m->vol = m->vol_prev = m->dvdt = m->x_prev = m->f = m->fp = m->fv = NULL;
+    m->p = m->vol = m->vol_prev = m->dvdt = m->x_prev = m->x_tri = m->f = m->fp = m->fv = NULL;
     m->x_cont = m->xid = m->rid = NULL;
     m->built = 0;
 }
@@ -43,11 +44,26 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
     pn_network_free(&m->net);
     pn_tri_free(&m->tri);
     double t0 = cputime();
-    if (pn_triangulate(&m->dom, n, x, r, m->margin, &m->tri, m->err, sizeof m->err)) return -1;
+    /* the width the last triangulation needed: the next one starts there (auto margin) */
+    if (pn_triangulate_with(&m->dom, n, x, r, m->margin > 0 ? m->margin : m->margin_used, m->tri_kind, &m->tri, m->err,
+                            sizeof m->err))
+        return -1;
+    m->margin_used = m->tri.margin;
+    if (m->tri.margin_needed > m->tri.margin && !(m->margin_warned & 2)) {
+        warn("porenet: pores at the faces have power spheres reaching beyond the widest image layer used (%g; "
+             "%g would make them exact): a sphere-free layer at a face? (porenet.margin)\n",
+             m->tri.margin, m->tri.margin_needed);
+        m->margin_warned |= 2;
+    } else if (m->margin > 0 && m->tri.margin > m->margin && !(m->margin_warned & 1)) {
+        warn("porenet: porenet.margin = %g is too narrow for this packing (pores at the faces need %g): "
+             "triangulated with %g\n",
+             m->margin, m->tri.margin_needed, m->tri.margin);
+        m->margin_warned |= 1;
+    }
     double t1 = cputime();
     if (pn_network_build(&m->dom, &m->prm, &m->tri, x, r, n, &m->net, m->err, sizeof m->err)) return -1;
     double t2 = cputime();
-    m->sol = pn_solver_create(&m->dom, &m->net, m->kind, m->pcg_tol, m->err, sizeof m->err);
+    m->sol = pn_solver_create_ordered(&m->dom, &m->net, m->kind, m->ordering, m->pcg_tol, m->err, sizeof m->err);
     if (!m->sol) return -1;
     m->t_tri = t1 - t0;
     m->t_net = t2 - t1;
@@ -65,7 +81,9 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
         m->fv = realloc(m->fv, 3 * (size_t)n * sizeof *m->fv);
         m->x_prev = realloc(m->x_prev, 3 * (size_t)n * sizeof *m->x_prev);
         m->x_cont = realloc(m->x_cont, 3 * (size_t)n * sizeof *m->x_cont);
+        m->x_tri = realloc(m->x_tri, 3 * (size_t)n * sizeof *m->x_tri);
     }
+    memcpy(m->x_tri, x, 3 * (size_t)n * sizeof *x);
     m->n = n;
     m->built = 1;
     m->n_retri++;

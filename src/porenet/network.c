@@ -485,6 +485,22 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
             for (int k = 0; k < 4; k++) {
                 int u = t->nbr[4 * tt + k];
                 if (u < 0) {
+                    /* the rim of the cloud: fine across the facet of a tetrahedron beyond a wall
+                     * (the half of a wall pore outside the box: its neighbours there are mirror
+                     * pores, whose throats are not kept); anywhere else the images are too few */
+                    int beyond = 0;
+                    for (int a = 0; a < 3 && !beyond; a++) {
+                        if (dom->periodic[a]) continue;
+                        int lo = 1, hi = 1;
+                        for (int v = 0; v < 4; v++) {
+                            if (v == k) continue;
+                            const double c = t->x[3 * (size_t)t->tet[4 * tt + v] + a];
+                            lo &= c < dom->lo[a];
+                            hi &= c > dom->hi[a];
+                        }
+                        beyond = lo || hi;
+                    }
+                    if (beyond) continue;
                     status = pn_fail(err, nerr,
                                   "pore %d reaches the rim of the triangulated cloud: image margin (%g) too small",
                                   pi, t->margin);

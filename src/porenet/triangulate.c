@@ -9,7 +9,9 @@
  * Images: every sphere closer than `margin` to a face is copied across it —
  * shifted by the period on a periodic axis, mirrored on a wall axis (edges
  * and corners get the combined copies) — so that the pores of the box are
- * complete and the wall planes are power bisectors (porenet.h).
+ * complete and the wall planes are power bisectors (porenet.h).  The margin
+ * is checked against what the tetrahedra of the box need (needed_margin: no
+ * image left out can be in conflict with them) and widened until it holds.
  *
  * Degeneracies (co-spherical sets: lattices, and every mirror-symmetric set
  * at a wall): qhull merges the coplanar lifted facets and option Qt splits
@@ -21,6 +23,7 @@
  * vertical facets at the rim of the cloud (note §6) are flat and outside the
  * kept region anyway.
  */
+#include <malloc.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -112,76 +115,116 @@ int pn_fail(char *err, size_t nerr, const char *fmt, ...)
     return -1;
 }
 
+/* The triangulation with the images within `margin` of the faces. */
+static int triangulate_once(const pn_domain_t *dom, int n, const double *x, const double *r, double margin, double rmax,
+                            pn_tri_kind_t kind, pn_tri_t *t, char *err, size_t nerr);
+
+/* The margin the tetrahedra of the box need: a point left out of the image
+ * layer (some coordinate beyond lo − m or hi + m) lies at least δ_a from the
+ * power centre P of a tetrahedron along that axis, so its power distance is
+ * at least δ_a² − r_max²; if that exceeds the tetrahedron's power radius² w,
+ * no such point can be in conflict with it (the empty-orthosphere property of
+ * a regular triangulation), and the tetrahedron is the one of the complete,
+ * unbounded image set.  Checked for the tetrahedra whose power centre lies in
+ * the box (the pores of the box, those on a wall plane included), widened
+ * along the periodic axes by twice the largest power radius of those inside
+ * (their neighbours across a periodic face: the throats to them are kept,
+ * and they must exist; across a wall they are mirror copies, whose throats
+ * are not, network.c).
+ * Returns the smallest margin meeting the condition for all of them. */
+static double needed_margin(const pn_domain_t *dom, const pn_tri_t *t, double rmax)
+{
+    double *w = malloc(((size_t)t->ntet + 1) * sizeof *w), hin = 0;
+    for (int k = 0; k < t->ntet; k++) {
+        const double *P = t->P + 3 * k, *c = t->x + 3 * (size_t)t->tet[4 * k];
+        const double rr = t->r[t->tet[4 * k]];
+        w[k] = (P[0] - c[0]) * (P[0] - c[0]) + (P[1] - c[1]) * (P[1] - c[1]) + (P[2] - c[2]) * (P[2] - c[2]) - rr * rr;
+        int in = 1;
+        for (int a = 0; a < 3; a++) in &= P[a] >= dom->lo[a] && P[a] <= dom->hi[a];
+        if (in && w[k] > 0) hin = fmax(hin, sqrt(w[k]));
+    }
+    /* across a periodic face the neighbours of the pores of the box must exist and be exact: copies
+     * of pores of the box, their power centres lie within 2 hin of the face (two power radii from a
+     * centre inside), their vertices within √(hin² + r_max²) of those */
+    double need = 0;
+    for (int a = 0; a < 3; a++)
+        if (dom->periodic[a]) need = fmax(need, 2 * hin + sqrt(hin * hin + rmax * rmax));
+    for (int k = 0; k < t->ntet; k++) {
+        const double *P = t->P + 3 * k;
+        int near = 1;
+        for (int a = 0; a < 3; a++) {
+            /* across a wall the pores are mirror copies (their throats are not kept); across a periodic
+             * face the neighbours are copies of the pores at the other face, whose throats are kept */
+            const double h = dom->periodic[a] ? 2 * hin : 1e-8 * (dom->hi[a] - dom->lo[a]);
+            near &= P[a] >= dom->lo[a] - h && P[a] <= dom->hi[a] + h;
+        }
+        if (!near) continue;
+        /* δ_a = m + (distance from P to the nearer face, negative outside) ≥ √(w + r_max²) */
+        const double reach = sqrt(fmax(w[k], 0.0) + rmax * rmax);
+        for (int a = 0; a < 3; a++) need = fmax(need, reach - fmin(P[a] - dom->lo[a], dom->hi[a] - P[a]));
+    }
+    free(w);
+    return need;
+}
+
 int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double *r, double margin, pn_tri_t *t,
                    char *err, size_t nerr)
 {
+    return pn_triangulate_with(dom, n, x, r, margin, PN_TRI_CGAL, t, err, nerr);
+}
+
+int pn_triangulate_with(const pn_domain_t *dom, int n, const double *x, const double *r, double margin,
+                        pn_tri_kind_t kind, pn_tri_t *t, char *err, size_t nerr)
+{
+    /* A rebuild frees the triangulation's large blocks and allocates the network's and the
+     * factor's: kept in the heap (not returned to the system and mapped again, page by page, at
+     * the next first touch) they are reused — measured 1.5-2x on the network's build at 30 000
+     * pores (docs/performance.md).  Process-wide, set once. */
+    static int heap_set = 0;
+    if (!heap_set) {
+        mallopt(M_MMAP_THRESHOLD, 32 << 20);
+        mallopt(M_TRIM_THRESHOLD, 64 << 20);
+        heap_set = 1;
+    }
     memset(t, 0, sizeof *t);
     if (n < 1) return pn_fail(err, nerr, "no spheres");
     double rmax = 0;
-    for (int i = 0; i < n; i++) {
-        rmax = fmax(rmax, r[i]);
-        for (int a = 0; a < 3; a++) {
-            double v = x[3 * i + a];
-            if (!(v >= dom->lo[a] && v <= dom->hi[a]))
-                return pn_fail(err, nerr, "sphere %d: centre (%g, %g, %g) outside the box", i, x[3 * i], x[3 * i + 1],
-                            x[3 * i + 2]);
-            /* A centre inside its own mirror image would be a hidden point
-             * (§1.2): the distance to a wall must exceed r/2. */
-            if (!dom->periodic[a] && (v - dom->lo[a] <= 0.5 * r[i] || dom->hi[a] - v <= 0.5 * r[i]))
-                return pn_fail(err, nerr, "sphere %d: centre closer than r/2 to a wall of axis %c (overlap with the wall)",
-                            i, 'x' + a);
-        }
+    for (int i = 0; i < n; i++) rmax = fmax(rmax, r[i]);
+    /* auto: start from 2.75 r_max (a dense packing's pores at a face need about 2.6 r_max).  A margin too
+     * narrow for the packing is widened to what the tetrahedra need (needed_margin), up to 6 r_max or
+     * the margin asked, whichever is wider, and below the box length; the pores that would need more
+     * (those of a sphere-free layer at a face: a fluid layer above a bed) are left as they are, and
+     * t->margin_needed > t->margin tells the caller */
+    double m = margin > 0 ? margin : 2.75 * rmax, cap = fmax(m, 6.0 * rmax);
+    for (int a = 0; a < 3; a++) cap = fmin(cap, 0.999 * (dom->hi[a] - dom->lo[a]));
+    for (int iter = 0;; iter++) {
+        if (triangulate_once(dom, n, x, r, m, rmax, kind, t, err, nerr)) return -1;
+        const double need = needed_margin(dom, t, rmax);
+        t->margin_needed = need;
+        if (need <= m || m >= cap || iter == 8) return 0;
+        pn_tri_free(t);
+        m = fmin(cap, fmax(1.05 * need, 1.25 * m));
     }
-    if (margin <= 0) margin = 6.0 * rmax;
-    t->margin = margin;
-    for (int a = 0; a < 3; a++)
-        if (margin >= dom->hi[a] - dom->lo[a])
-            return pn_fail(err, nerr, "box length along %c (%g) is not larger than the image margin %g (3 diameters)",
-                        'x' + a, dom->hi[a] - dom->lo[a], margin);
+}
 
-    /* ---- extended point set ---- */
-    size_t cap = (size_t)n * 2 + 64, np = 0;
-    double *X = malloc(3 * cap * sizeof *X), *R = malloc(cap * sizeof *R);
-    int *ID = malloc(cap * sizeof *ID);
-    signed char *IMG = malloc(3 * cap);
-    for (int s = 0; s < 27; s++) {
-        int sh[3] = {s % 3 - 1, (s / 3) % 3 - 1, s / 9 - 1};
-        for (int i = 0; i < n; i++) {
-            double y[3];
-            int ok = 1;
-            for (int a = 0; a < 3 && ok; a++) {
-                y[a] = image_coord(dom, a, sh[a], x[3 * i + a]);
-                if (sh[a] != 0 && !(y[a] > dom->lo[a] - margin && y[a] < dom->hi[a] + margin)) ok = 0;
-            }
-            if (!ok) continue;
-            if (np == cap) {
-                cap *= 2;
-                X = realloc(X, 3 * cap * sizeof *X);
-                R = realloc(R, cap * sizeof *R);
-                ID = realloc(ID, cap * sizeof *ID);
-                IMG = realloc(IMG, 3 * cap);
-            }
-            memcpy(X + 3 * np, y, sizeof y);
-            R[np] = r[i];
-            ID[np] = i;
-            for (int a = 0; a < 3; a++) IMG[3 * np + a] = (signed char)sh[a];
-            np++;
-        }
-    }
-    t->npts = (int)np;
-    t->xm = malloc(3 * np * sizeof *t->xm);
-    t->xo = malloc(3 * np * sizeof *t->xo);
-    for (size_t p = 0; p < np; p++)
-        for (int a = 0; a < 3; a++) {
-            const int s = IMG[3 * p + a];
-            t->xm[3 * p + a] = (s != 0 && !dom->periodic[a]) ? -1.0 : 1.0;
-            t->xo[3 * p + a] = s == 0 ? 0.0 : dom->periodic[a] ? s * (dom->hi[a] - dom->lo[a]) : s < 0 ? 2.0 * dom->lo[a] : 2.0 * dom->hi[a];
-        }
-    t->x = X;
-    t->r = R;
-    t->id = ID;
-    t->img = IMG;
+/* The tetrahedra of the point set by CGAL (regular_cgal.cpp): every cell has a
+ * positive volume, its power centre CGAL's weighted circumcentre (cond 1: the
+ * members of a merged pore agree to the merging tolerance, network.c). */
+static int tets_cgal(pn_tri_t *t, char *err, size_t nerr)
+{
+    if (pn_cgal_regular(t->npts, t->x, t->r, &t->ntet, &t->tet, &t->nbr, &t->P, err, nerr)) return -1;
+    const int nt = t->ntet;
+    t->cond = malloc(((size_t)nt + 1) * sizeof *t->cond);
+    t->grp = malloc(((size_t)nt + 1) * sizeof *t->grp);
+    for (int k = 0; k < nt; k++) t->cond[k] = 1, t->grp[k] = -1;
+    return 0;
+}
 
+/* The tetrahedra of the point set by qhull's 4-D lift (the lower hull). */
+static int tets_qhull(const pn_domain_t *dom, pn_tri_t *t, double margin, char *err, size_t nerr)
+{
+    const double *X = t->x, *R = t->r;
+    const size_t np = (size_t)t->npts;
     /* Lifted coordinates, centred on the box and scaled to O(1) so that qhull's
      * precision (relative to the largest coordinate) is not wasted. */
     double ctr[3], scale = 0;
@@ -296,3 +339,75 @@ int pn_triangulate(const pn_domain_t *dom, int n, const double *x, const double 
     free(pts);
     return 0;
 }
+
+static int triangulate_once(const pn_domain_t *dom, int n, const double *x, const double *r, double margin, double rmax,
+                            pn_tri_kind_t kind, pn_tri_t *t, char *err, size_t nerr)
+{
+    memset(t, 0, sizeof *t);
+    for (int i = 0; i < n; i++) {
+        for (int a = 0; a < 3; a++) {
+            double v = x[3 * i + a];
+            if (!(v >= dom->lo[a] && v <= dom->hi[a]))
+                return pn_fail(err, nerr, "sphere %d: centre (%g, %g, %g) outside the box", i, x[3 * i], x[3 * i + 1],
+                            x[3 * i + 2]);
+            /* A centre inside its own mirror image would be a hidden point
+             * (§1.2): the distance to a wall must exceed r/2. */
+            if (!dom->periodic[a] && (v - dom->lo[a] <= 0.5 * r[i] || dom->hi[a] - v <= 0.5 * r[i]))
+                return pn_fail(err, nerr, "sphere %d: centre closer than r/2 to a wall of axis %c (overlap with the wall)",
+                            i, 'x' + a);
+        }
+    }
+    (void)rmax;
+    t->margin = margin;
+    for (int a = 0; a < 3; a++)
+        if (margin >= dom->hi[a] - dom->lo[a])
+            return pn_fail(err, nerr, "box length along %c (%g) is not larger than the image margin %g",
+                        'x' + a, dom->hi[a] - dom->lo[a], margin);
+
+    /* ---- extended point set ---- */
+    size_t cap = (size_t)n * 2 + 64, np = 0;
+    double *X = malloc(3 * cap * sizeof *X), *R = malloc(cap * sizeof *R);
+    int *ID = malloc(cap * sizeof *ID);
+    signed char *IMG = malloc(3 * cap);
+    for (int s = 0; s < 27; s++) {
+        int sh[3] = {s % 3 - 1, (s / 3) % 3 - 1, s / 9 - 1};
+        for (int i = 0; i < n; i++) {
+            double y[3];
+            int ok = 1;
+            for (int a = 0; a < 3 && ok; a++) {
+                y[a] = image_coord(dom, a, sh[a], x[3 * i + a]);
+                if (sh[a] != 0 && !(y[a] > dom->lo[a] - margin && y[a] < dom->hi[a] + margin)) ok = 0;
+            }
+            if (!ok) continue;
+            if (np == cap) {
+                cap *= 2;
+                X = realloc(X, 3 * cap * sizeof *X);
+                R = realloc(R, cap * sizeof *R);
+                ID = realloc(ID, cap * sizeof *ID);
+                IMG = realloc(IMG, 3 * cap);
+            }
+            memcpy(X + 3 * np, y, sizeof y);
+            R[np] = r[i];
+            ID[np] = i;
+            for (int a = 0; a < 3; a++) IMG[3 * np + a] = (signed char)sh[a];
+            np++;
+        }
+    }
+    t->npts = (int)np;
+    t->xm = malloc(3 * np * sizeof *t->xm);
+    t->xo = malloc(3 * np * sizeof *t->xo);
+    for (size_t p = 0; p < np; p++)
+        for (int a = 0; a < 3; a++) {
+            const int s = IMG[3 * p + a];
+            t->xm[3 * p + a] = (s != 0 && !dom->periodic[a]) ? -1.0 : 1.0;
+            t->xo[3 * p + a] = s == 0 ? 0.0 : dom->periodic[a] ? s * (dom->hi[a] - dom->lo[a]) : s < 0 ? 2.0 * dom->lo[a] : 2.0 * dom->hi[a];
+        }
+    t->x = X;
+    t->r = R;
+    t->id = ID;
+    t->img = IMG;
+
+    if (kind == PN_TRI_CGAL) return tets_cgal(t, err, nerr);
+    return tets_qhull(dom, t, margin, err, nerr);
+}
+

@@ -1,0 +1,231 @@
+/* test_dem_drag.c — the drag closure of the reduced fluid model `drag`
+ * ([coupling] fluid = drag; src/dem/drag.c, docs/theory.md "Drag closure").
+ * RANKS: 1 2
+ *
+ * Exact results used:
+ *  - An isolated sphere released from rest in a fluid at rest reaches
+ *    Stokes's terminal velocity v_t = (ρ_p − ρ_f) g d²/(18 μ) (the immersed
+ *    weight against 3π μ d v), with either closure (its local solid fraction
+ *    is 0: it is left out of its own sampling ball).  The backward-Euler
+ *    relaxation of the half-step velocity has that fixed point exactly, so the
+ *    velocity from the positions after 40 τ (τ = m/(3π μ d)) is v_t to
+ *    round-off; its approach follows the scheme's recurrence v_k = (v_{k−1} +
+ *    Δt g′ + (Δt/τ) U_f)/(1 + Δt/τ) (the displacement to t = τ checked to
+ *    round-off, and the velocity within Δt/τ of the exact v_t (1 − e^−1)).  With a prescribed fluid velocity U_f
+ *    the sphere moves at U_f + v_t.  Its Stokes torque −π μ d³ ω decays a spin
+ *    as (1 + Δt/τ_r)^−k, τ_r = I/(π μ d³).
+ *  - Hindered settling of a homogeneous suspension (triply periodic box, 382
+ *    spheres at φ = 0.2, and 191 at 0.1, closure richardson_zaki): the
+ *    momentum balance of the whole suspension (contacts cancel in pairs)
+ *    gives ⟨Σ_i K(φ_i) v_i⟩/N = v_t exactly on time average; and the mean
+ *    settling velocity is Richardson & Zaki's v_t (1 − φ)^4.65 within the
+ *    bias of the local-fraction estimate (docs/theory.md: the other spheres
+ *    cannot come closer than d, which the sampling ball's count shows as a
+ *    deficit of about v_p (1 − φ − S(0))/(|B| − v_p), S(0) the hard-sphere
+ *    structure factor; measured below).
+ *  - A restart from a checkpoint between two updates of the local fractions
+ *    continues exactly (the held fractions are in the checkpoint).
+ */
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "dem.h"
+#include "modules.h"
+#include "testutil.h"
+#include "util.h"
+
+static const double D = 1e-3, RHO_P = 2500, RHO_F = 1000, MU = 0.1, G = 9.81, TC = 1e-4;
+
+static dem_t *make(const char *particles, const char *drag_keys, const char *boundary)
+{
+    char text[4096];
+    snprintf(text, sizeof text,
+             "[domain]\nlength = 0.01 0.01 0.01\n%s"
+             "[particles]\n%s\n"
+             "[contact]\nrestitution = 0.5\ncontact_time = %g\nfriction = 0.3\n"
+             "[dem]\ngravity = 0 0 %g\nsteps_per_contact = 20\n"
+             "[coupling]\nfluid = drag\n"
+             "[drag]\nviscosity = %g\nfluid_density = %g\n%s",
+             boundary, particles, TC, -G, MU, RHO_F, drag_keys);
+    cfg_t *cfg = cfg_load_string("test.ini", text, 0, NULL);
+    assert_non_null(cfg);
+    dem_t *d = dem_create_from_config(cfg, MPI_COMM_WORLD);
+    cfg_free(cfg);
+    return d;
+}
+
+static const char *PERIODIC = "[boundary]\nx_lo = periodic\nx_hi = periodic\ny_lo = periodic\ny_hi = periodic\n"
+                              "z_lo = periodic\nz_hi = periodic\n";
+
+/* Mean z velocity of the particles from their displacement over n steps
+ * (the drift velocities: the stored full-step velocities carry half a kick
+ * of gravity without its drag). */
+static double mean_vz(dem_t *d, long n)
+{
+    const int np = dem_count(d);
+    double *z0 = malloc((size_t)np * sizeof *z0);
+    long *id0 = malloc((size_t)np * sizeof *id0);
+    for (int i = 0; i < np; i++) id0[dem_ids(d)[i]] = i, z0[dem_ids(d)[i]] = dem_positions(d)[3 * i + 2];
+    const double t0 = dem_time(d);
+    double zs = 0;
+    for (long k = 0; k < n; k++) assert_int_equal(dem_step(d), DEM_OK);
+    /* unwrapped: no sphere moves more than half the box in n steps here */
+    for (int i = 0; i < np; i++) {
+        double dz = dem_positions(d)[3 * i + 2] - z0[dem_ids(d)[i]];
+        dz -= 0.01 * nearbyint(dz / 0.01);
+        zs += dz;
+    }
+    free(z0);
+    free(id0);
+    return zs / np / (dem_time(d) - t0);
+}
+
+static void test_isolated_sphere(void **state)
+{
+    (void)state;
+    const double vt = (RHO_P - RHO_F) * G * D * D / (18 * MU), m = RHO_P * M_PI / 6 * D * D * D;
+    const double tau = m / (3 * M_PI * MU * D);
+    for (int closure = 0; closure < 2; closure++)
+        for (int moving = 0; moving < 2; moving++) {
+            char keys[256];
+            snprintf(keys, sizeof keys, "closure = %s\nfluid_velocity = 0 0 %s\n", closure ? "richardson_zaki" : "stokes",
+                     moving ? "0.002" : "0");
+            dem_t *d = make("source = list\nparticle1 = center 0.005 0.005 0.005 diameter 0.001 density 2500 "
+                            "omega 30 0 0",
+                            keys, PERIODIC);
+            assert_int_equal(dem_advance(d, 0.0), DEM_OK);
+            const double dt = dem_dt(d), a = dt / tau;
+            const long k1 = lround(tau / dt);
+            /* the scheme's own transient: the first step kicks half Δt of gravity (velocity Verlet), the
+             * next ones Δt; the buoyancy is applied with the drag over each drift */
+            const double U = moving ? 0.002 : 0, gb = -G + RHO_F / RHO_P * G;
+            double zsum = 0, vk = 0;
+            for (long k = 1; k <= k1; k++) {
+                vk = (vk + (k == 1 ? 0.5 * dt * -G + dt * (gb + G) : dt * gb) + a * U) / (1 + a);
+                zsum += dt * vk;
+            }
+            const double z0 = dem_positions(d)[2];
+            for (long k = 0; k < k1; k++) assert_int_equal(dem_step(d), DEM_OK);
+            double dz = dem_positions(d)[2] - z0;
+            const double e_scheme = fabs(dz - zsum) / fabs(zsum);
+            /* the velocity of the k1-th drift against the exact transient at t = τ (first order in Δt/τ) */
+            const double vx = (U - vt) * (1 - exp(-k1 * dt / tau));
+            const double w1 = dem_omegas(d)[0];
+            for (long k = 0; k < 39 * k1; k++) assert_int_equal(dem_step(d), DEM_OK);
+            const double v = mean_vz(d, 100) - (moving ? 0.002 : 0);
+            const double I = 0.1 * m * D * D, taur = I / (M_PI * MU * D * D * D);
+            const double w_exp = 30 * pow(1 + dt / taur, -(double)k1);
+            printf("# closure %s, U_f %s: terminal %.10g (Stokes %.10g, rel. %.1e); displacement to t = tau %.2e "
+                   "from the scheme's; v(tau) %.6f of v_t (exact %.6f, dt/tau %.2e); spin after tau %.6g (scheme %.6g)\n",
+                   closure ? "richardson_zaki" : "stokes", moving ? "0.002" : "0", -v, vt, fabs(-v - vt) / vt, e_scheme,
+                   vk / (U - vt), vx / (U - vt), a, w1, w_exp);
+            /* round-off: 4e4 steps of sums of ~1e-6 m displacements */
+            assert_true(fabs(-v - vt) / vt < 1e-9);
+            assert_true(e_scheme < 1e-9);
+            assert_true(fabs(vk - vx) / fabs(U - vt) < a);
+            assert_true(fabs(w1 - w_exp) < 1e-9 * 30);
+            dem_free(d);
+        }
+}
+
+/* Hindered settling at solid fraction phi: returns the mean settling velocity
+ * over v_t, and the measured mean local fraction; checks the momentum balance. */
+static double suspension(double phi, int seed, double *phi_mean, double *balance)
+{
+    char parts[256];
+    snprintf(parts, sizeof parts, "source = insert\nvolume_fraction = %g\nradius = 0.0005\ndensity = 2500\nseed = %d\n",
+             phi, seed);
+    dem_t *d = make(parts, "closure = richardson_zaki\n", PERIODIC);
+    const double vt = (RHO_P - RHO_F) * G * D * D / (18 * MU), m = RHO_P * M_PI / 6 * D * D * D;
+    const double tau = m / (3 * M_PI * MU * D);
+    assert_int_equal(dem_advance(d, 0.0), DEM_OK);
+    const long nt = lround(tau / dem_dt(d));
+    /* transient: the slowest relaxation is τ/K(φ) < τ; 15 τ */
+    for (long k = 0; k < 15 * nt; k++) assert_int_equal(dem_step(d), DEM_OK);
+    /* averages over 10 τ, in blocks of τ/4 */
+    double v = 0, bal = 0, ph = 0;
+    const int nb = 40;
+    for (int b = 0; b < nb; b++) {
+        v += mean_vz(d, nt / 4) / nb;
+        const double *f = dem_drag_fraction(d), *fd = dem_drag_forces(d);
+        double s = 0, p = 0;
+        for (int i = 0; i < dem_count(d); i++) {
+            const long id = dem_ids(d)[i];
+            s += fd[3 * id + 2];
+            p += f[id];
+        }
+        /* Σ F_drag,z = Σ 3π μ d K_i v_i: the drag carries the immersed weight on average */
+        bal += s / dem_count(d) / ((RHO_P - RHO_F) * M_PI / 6 * D * D * D * G) / nb;
+        ph += p / dem_count(d) / nb;
+    }
+    *phi_mean = ph;
+    *balance = bal;
+    dem_free(d);
+    return -v / vt;
+}
+
+static void test_hindered_settling(void **state)
+{
+    (void)state;
+    const double n = 4.65, phis[2] = {0.1, 0.2};
+    for (int q = 0; q < 2; q++) {
+        double pm, bal;
+        const double phi = phis[q], u = suspension(phi, 7, &pm, &bal), rz = pow(1 - phi, n), rz_est = pow(1 - pm, n);
+        /* the deficit of the estimate: hard spheres, Percus–Yevick S(0) = (1 − φ)^4/(1 + 2φ)^2, ball of 3 d */
+        const double S0 = pow(1 - phi, 4) / pow(1 + 2 * phi, 2), vp = M_PI / 6, vb = 4.0 / 3.0 * M_PI * 27;
+        const double deficit = vp * (1 - phi - S0) / (vb - vp);
+        printf("# phi %.2f: settling %.4f v_t, Richardson-Zaki %.4f (rel. %+.3f), at the mean estimated fraction "
+               "%.4f: %.4f (rel. %+.3f); estimated fraction %+.4f from phi (expected deficit %.4f); drag / immersed "
+               "weight %.5f\n",
+               phi, u, rz, u / rz - 1, pm, rz_est, u / rz_est - 1, pm - phi, deficit, bal);
+        /* the momentum balance: 1 up to the fluctuation of the time average (measured within 2e-3) */
+        assert_true(fabs(bal - 1) < 5e-3);
+        /* the estimator: its mean within 0.005 of phi + the expected deficit (sampling noise of ~400 balls) */
+        assert_true(fabs(pm - (phi - deficit)) < 0.005);
+        /* Richardson-Zaki: within 4 % (measured below 2 %: the estimator's deficit and the spread of K over
+         * the spheres, <K v> = v_t but <v> > v_t/<K>) */
+        assert_true(fabs(u / rz - 1) < 0.04);
+    }
+}
+
+static void test_restart(void **state)
+{
+    (void)state;
+    char dir[] = "/tmp/ibmdem_drag_XXXXXX";
+    if (mpi_rank() == 0) assert_non_null(mkdtemp(dir));
+    MPI_Bcast(dir, sizeof dir, MPI_CHAR, 0, MPI_COMM_WORLD);
+    char path[512];
+    snprintf(path, sizeof path, "%s/c.h5", dir);
+    const char *parts = "source = insert\nvolume_fraction = 0.2\nradius = 0.0005\ndensity = 2500\nseed = 3\n";
+    dem_t *a = make(parts, "fraction_every = 7\n", PERIODIC);
+    assert_int_equal(dem_run_steps(a, 103), DEM_OK); /* between two updates of phi */
+    dem_write_checkpoint(a, path);
+    dem_t *b = make(parts, "fraction_every = 7\n", PERIODIC);
+    dem_read_checkpoint(b, path);
+    assert_int_equal(dem_run_steps(a, 200), DEM_OK);
+    assert_int_equal(dem_run_steps(b, 200), DEM_OK);
+    double diff = 0;
+    for (int i = 0; i < 3 * dem_count(a); i++)
+        diff = fmax(diff, fabs(dem_positions(a)[i] - dem_positions(b)[i]) + fabs(dem_velocities(a)[i] - dem_velocities(b)[i]));
+    printf("# restart between two updates of the local fractions: largest difference %g\n", diff);
+    assert_true(diff == 0);
+    dem_free(a);
+    dem_free(b);
+    if (mpi_rank() == 0) {
+        unlink(path);
+        rmdir(dir);
+    }
+}
+
+int main(int argc, char **argv)
+{
+    test_mpi_init(&argc, &argv);
+    modules_register_keys();
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_isolated_sphere),
+        cmocka_unit_test(test_hindered_settling),
+        cmocka_unit_test(test_restart),
+    };
+    TEST_MPI_RUN("dem_drag", tests);
+}
