@@ -38,6 +38,11 @@ static const cfg_key_t ibm_keys[] = {
      "Runge-Kutta stage (stage), or held where the step started and moved between steps, the fluid momentum "
      "over the jump counted in the next force (step: one rebuild per step instead of three, see "
      "docs/theory.md)"},
+    {"ibm", "cn_forcing", CFG_ENUM, "after_solve", 1, 0, "after_solve|predictor",
+     "with the Crank-Nicolson viscous term ([fluid] viscous = implicit, or auto on its implicit steps): the forcing is computed from the Crank-Nicolson solution and applied "
+     "after the solve (after_solve), or from the explicit predictor with the whole viscous term and applied as a "
+     "source term of the implicit solve (predictor: stable and accurate at large Δt ν/Δx², see docs/theory.md "
+     "§4.6); no effect with the explicit viscous term"},
     {"ibm", "retraction", CFG_DOUBLE, "0", -1, 1, NULL,
      "the solid fraction is that of a sphere of radius R - retraction × Δx (cells): compensates the effective "
      "thickening of the forced sphere (0: the seed's method)"},
@@ -204,6 +209,8 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
     if (f->stage_begin_hook || f->plane_hook || f->stage_hook || f->stage_end_hook)
         die("immersed boundary: the fluid's stage hooks are already in use");
     if (g->nalloc >= INT32_MAX) die("immersed boundary: a field of %ld values is too large for the node lists", g->nalloc);
+    if (prm->forcing_predictor && prm->forcing_iterations > 0 && f->prm.implicit_viscous)
+        die("immersed boundary: forcing iterations act after the Crank-Nicolson solve, not with the predictor forcing");
     for (int d = 0; d < g->dim; d++)
         if (g->periodic[d] && g->n[d] > 127 * 1000000) die("immersed boundary: grid too large");
     ibm_t *ibm = xcalloc(1, sizeof *ibm);
@@ -536,6 +543,10 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
     if (prm.radius_calibrated && prm.forcing_iterations > 0)
         cfg_fail(cfg, "ibm", "radius_correction", "calibrated needs forcing_iterations = 0 (the calibrated forcing)");
     prm.free_alpha_per_step = cfg_enum(cfg, "ibm", "free_alpha");
+    prm.forcing_predictor = cfg_enum(cfg, "ibm", "cn_forcing") == 1;
+    if (prm.forcing_predictor && prm.forcing_iterations > 0 && f->prm.implicit_viscous)
+        cfg_fail(cfg, "ibm", "forcing_iterations",
+                 "the forcing iterations (project, force) act after the solve: not with cn_forcing = predictor");
     if (g->geom == GEOM_AXI && (prm.gravity[0] != 0.0 || prm.gravity[2] != 0.0))
         cfg_fail(cfg, "ibm", "gravity", "an axisymmetric gravity must be axial (y)");
     if (g->dim == 2 && prm.gravity[2] != 0.0) cfg_fail(cfg, "ibm", "gravity", "a 2-D grid has no z direction");
