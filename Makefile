@@ -6,6 +6,8 @@
 #   make restitution  restitution sweeps (wall and binary; about 15 min on 2 cores);
 #                   RESTITUTION_SET='section.key=value ...' overrides keys in every run,
 #                   RESTITUTION_OUT=dir the output directory (default build/restitution)
+#   make viscous_stability  the stability map of the coupled step at large viscous numbers
+#                   (build/viscous_stability/map.md; ~25 min on 2 cores)
 #   make bounce     the bouncing sphere against experiments, lubrication cut-off, oblique bounces (FULL=1: finer)
 #   make fuzz       the long fuzz series of tests/fuzz.py (40 check and 8 run mutants of every case file;
 #                   FUZZ_SEED=N other mutants, FUZZ_ARGS='--checks 200' more); make test runs a quick subset
@@ -43,7 +45,7 @@ BIN     := $(BUILD)/ibmdem
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 BENCHES := $(patsubst bench/%.c,$(BUILD)/bench/%,$(wildcard bench/bench_*.c))
 
-.PHONY: all test demo validate bench deps clean restitution bounce fuzz
+.PHONY: all test demo validate bench deps clean restitution viscous_stability bounce fuzz
 all: $(BIN) $(TESTS) $(BENCHES)
 
 $(BUILD)/obj/%.o: src/%.c
@@ -106,6 +108,11 @@ restitution: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bash scripts/restitution.sh $(RESTITUTION_OUT) full $(RESTITUTION_SET)
 
+# the stability map of the coupled step at large viscous numbers (docs/theory.md §4.6, §9.1):
+# build/viscous_stability/map.md
+viscous_stability: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bash scripts/viscous_stability.sh $(BUILD)/viscous_stability
 # the bouncing sphere against the experiments of Gondret et al. (2002), the lubrication cut-off and the
 # oblique bounces (part of make validate); FULL=1 adds D/dx = 40 (and 30 at St 152): about 3 hours
 bounce: deps

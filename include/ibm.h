@@ -22,7 +22,9 @@
  *     u ← u + β (U − u)      (f = β (U − u*)/Δt_k),
  * with α the smoothed solid fraction of decision 1 at each staggered node
  * and β = α (the seed's forcing) or its time-step independent form
- * β = α Δt_k/((1 − α)τ + α Δt_k) (forcing.c);
+ * β = α Δt_k/((1 − α)τ + α Δt_k) (forcing.c); with the Crank–Nicolson
+ * viscous term either after the implicit solve (cn_forcing = after_solve) or,
+ * from the explicit predictor, as a source term of it (predictor);
  * after the projection the momentum integrals are taken and the spheres are
  * moved.  Geometries: 3-D (spheres), 2-D (discs, per unit depth) and
  * axisymmetric (spheres on the axis, moving along it, integrals with 2πr).
@@ -86,10 +88,14 @@ typedef struct {
     int forcing_iterations; /* extra force + project passes per stage (0: one forcing) */
     double gravity[3];    /* acts on the particles only (pressure relative to hydrostatic) */
     double retraction;    /* α is taken for the radius R − retraction × h (h the cell size) */
+    int radius_calibrated; /* 1: and less the calibrated thickening of the band, ibm_calibrated_retraction() */
     double forcing_time;  /* κ: partially covered nodes relax towards U with the time scale
                            * τ = κ h²/ν (0: the seed's u ← u + α (U − u) at every stage) */
     int free_alpha_per_step; /* 1: a free sphere's α is held over the fluid step and moved
                               * between steps (docs/theory.md §6b); 0: moved after every stage */
+    int forcing_predictor; /* Crank–Nicolson: 1: forcing of the explicit predictor, a source term of
+                            * the implicit solve (FLUID_HOOK_PREDICTOR, docs/theory.md §4.6);
+                            * 0: forcing of the solved velocity (after the solve) */
 } ibm_params_t;
 
 typedef struct ibm ibm_t;
@@ -167,6 +173,15 @@ double ibm_stable_dt(const ibm_t *ibm, double cfl);
  * α = ½[1 − tanh(d/(σλΔ))], λ = |n_x|+|n_y|+|n_z|, σ = 0.065(1 − λ²) + 0.39,
  * Δ = √2 h, then the continuous cut of IBM_ALPHA_CUT. */
 double ibm_alpha(double d, const double n[3], double h);
+
+/* The calibrated retraction (cells) of `radius_correction = calibrated`:
+ * r(κ) − 0.282 h/R, r(κ) the first-order thickening of the band measured
+ * for forcing_time κ ∈ [0.1, 0.3] (docs/theory.md §6b). */
+double ibm_calibrated_retraction(double kappa, double h_over_R);
+
+/* The radius whose smoothed indicator is forced for a sphere of radius R at
+ * cell size h: R − retraction h, less the calibrated retraction if chosen. */
+double ibm_forced_radius(const ibm_t *ibm, double R, double h);
 /* Half-width of the band where 0 < α < 1, in units of h. */
 double ibm_band_halfwidth(void);
 

@@ -24,6 +24,8 @@ check axis "${axi}sphere1 = free center 0.2 0.5 0 radius 0.1 density 2\n" "ibm.s
 check swirl "${axi}sphere1 = prescribed center 0 0.5 0 radius 0.1 omega 0 1 0\n" "ibm.sphere1: an axisymmetric sphere cannot rotate"
 check rigid1 "${base3d}force_model = rigid\nsphere1 = free center 0.5 0.5 0.5 radius 0.1 density 1\n" "ibm.force_model: rigid divides by"
 check history "${base3d}sphere1 = fixed center 0.5 0.5 0.5 radius 0.1 history h.csv\n" "ibm.sphere1: a velocity history needs the kind prescribed"
+check calkappa "${base3d}radius_correction = calibrated\nsphere1 = fixed center 0.5 0.5 0.5 radius 0.1\n" "ibm.radius_correction: calibrated needs forcing_time in \\[0.1, 0.3\\]"
+check caliter "${base3d}radius_correction = calibrated\nforcing_time = 0.2\nforcing_iterations = 1\nsphere1 = fixed center 0.5 0.5 0.5 radius 0.1\n" "ibm.radius_correction: calibrated needs forcing_iterations = 0"
 check nofluid '[domain]\nnx = 8\nny = 8\nnz = 8\nlength = 1 1 1\n[time]\nt_end = 1\n[ibm]\nsphere1 = fixed center 0.5 0.5 0.5 radius 0.1\n' "ibm.sphere1: an immersed boundary needs a fluid"
 printf 'x,y,z,radius\n0.5,0.5,0.5,0.1\n0.2,0.2\n' >$T/s.csv
 check csv "${base3d}spheres_file = $T/s.csv\ndensity = 2\n" "ibm.spheres_file: $T/s.csv:3: 2 values for 4 columns"

@@ -48,6 +48,11 @@ static const cfg_key_t coupling_keys[] = {
     {"coupling", "added_mass_coefficient", CFG_DOUBLE, "0.5", 0, 10, NULL,
      "added_mass = consistent: C_M (1/2, a sphere in unbounded fluid, the seed's value for walls and pairs; "
      "0.803, a sphere touching a wall or the symmetry plane of two equal spheres, docs/theory.md §9.1)"},
+    {"coupling", "implicit_drag", CFG_DOUBLE, "0", 0, 1e6, NULL,
+     "K > 0: inside the DEM sub-steps the held hydrodynamic force and torque respond to the particle's velocity "
+     "change since the fluid step, -K 3 pi eta D (U - U_n) and -K pi eta D^3 (omega - omega_n), so that a particle "
+     "whose relaxation time is shorter than the fluid step is not driven by a stale force (docs/theory.md §9.1); "
+     "0: the held force alone (the seed's)"},
     {"coupling", "restitution_axis", CFG_VEC3, NULL, -1e300, 1e300, NULL,
      "wall: direction from the particle towards the wall (default: along gravity)"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
@@ -73,6 +78,7 @@ typedef struct {
     coupling_numbers_t num; /* of particle 0 (a bounce) or of the mean particle; num.D = 0: none */
     coupling_freeze_t fz;
     coupling_added_mass_t am; /* [coupling] added_mass = consistent (am.n > 0) */
+    coupling_drag_t drag;     /* [coupling] implicit_drag > 0 (drag.n > 0) */
     double wall_dem;     /* wall time in the DEM */
     long substeps;       /* DEM sub-steps done */
     /* the state at the start of the step (rollback) */
@@ -196,6 +202,36 @@ static double part_align_dt(void *ctx, double T)
     return aim > T ? 0.5 * aim : aim;
 }
 
+/* The step limit of the particles' acceleration from rest (the immersed
+ * boundary limits the step by their velocities, ibm_stable_dt): a particle
+ * at rest, whose held force vanished, accelerates at most by its immersed
+ * weight, a = |g| (m_p − ρV_p)/m (m with any added mass), and moves a cell
+ * in √(2h/a): the step is at most the CFL target over √(a/h), as the
+ * immersed boundary does for a free sphere.  (With implicit_drag a single
+ * particle's speed within the step stays below a m/c, c = K 3πηD, but the
+ * fluid a settling crowd sets in motion does not: that bound let a scene of
+ * 150 grains at rest take a first step that put the fluid at CFL 2.) */
+static double part_stable_dt(void *ctx)
+{
+    coupling_part_t *cp = ctx;
+    setup(cp);
+    if (!cp->ibm || cp->sim->fluid->prm.dt_fixed > 0) return INFINITY;
+    const grid_t *g = cp->ibm->g;
+    const double h = grid_min_spacing(g);
+    const double gg = sqrt(cp->gravity[0] * cp->gravity[0] + cp->gravity[1] * cp->gravity[1] +
+                           cp->gravity[2] * cp->gravity[2]);
+    const double *r = dem_radii(cp->d);
+    const unsigned char *fx = dem_fixed(cp->d);
+    double rate = 0.0;
+    for (int i = 0; i < dem_count(cp->d); i++) {
+        if (fx[i]) continue;
+        const double V = 4.0 / 3.0 * M_PI * r[i] * r[i] * r[i], m = dem_mass(cp->d, i);
+        const double a = gg * fabs(dem_density(cp->d, i) - cp->rho_f) * V / m;
+        rate = fmax(rate, sqrt(a / h));
+    }
+    return rate > 0 ? cp->sim->fluid->prm.cfl / rate : INFINITY;
+}
+
 static void part_advance(void *ctx, double dt)
 {
     coupling_part_t *cp = ctx;
@@ -204,7 +240,8 @@ static void part_advance(void *ctx, double dt)
         const double w0 = wtime();
         coupling_added_mass_t *am = cp->am.n ? &cp->am : NULL;
         coupling_forces_to_dem(cp->ibm, cp->d, cp->rho_f, cp->gravity, cp->fz.n ? &cp->fz : NULL, am, dt);
-        cp->status = dem_advance(cp->d, dem_time(cp->d) + dt);
+        cp->status = cp->drag.n ? coupling_drag_advance(&cp->drag, cp->ibm, cp->d, am, dt)
+                                : dem_advance(cp->d, dem_time(cp->d) + dt);
         if (am) coupling_added_mass_after_step(am, cp->d);
         cp->wall_dem += wtime() - w0;
         if (cp->status == DEM_OK) coupling_motion_to_ibm(cp->d, cp->ibm);
@@ -483,6 +520,7 @@ static void part_destroy(void *ctx)
     coupling_part_t *cp = ctx;
     coupling_freeze_free(&cp->fz);
     coupling_added_mass_free(&cp->am);
+    coupling_drag_free(&cp->drag);
     restitution_free(&cp->rest);
     free(cp->prev_fz);
     free(cp->prev_dU);
@@ -521,6 +559,9 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
     if (ibm && ibm->n > 0 && cfg_enum(cfg, "coupling", "added_mass") == 1)
         coupling_added_mass_init(&cp->am, ibm->n, cfg_double(cfg, "coupling", "added_mass_coefficient"));
     cp->stop_after = mode != RESTITUTION_OFF && cfg_bool(cfg, "coupling", "stop_after_rebound");
+    if (ibm && ibm->n > 0 && cfg_double(cfg, "coupling", "implicit_drag") > 0)
+        coupling_drag_init(&cp->drag, ibm->n, cfg_double(cfg, "coupling", "implicit_drag"),
+                           s->fluid->prm.rho * s->fluid->prm.nu);
     /* the lubrication correction adds what the grid does not resolve: it needs the grid spacing
      * (before the packing preparation, whose lists must hold every lubricated pair) */
     if (ibm) dem_lubrication_set_grid(sim_dem_engine_unprepared(s), grid_min_spacing(s->fluid->g));
@@ -532,6 +573,7 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
     sim_part_t part = {
         .name = "coupling",
         .ctx = cp,
+        .stable_dt = part_stable_dt,
         .align_dt = part_align_dt,
         .advance = part_advance,
         .ncol = mode ? 2 : 0,

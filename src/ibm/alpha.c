@@ -190,7 +190,7 @@ static inline long plane_segments_max(const grid_t *g, const int lo[3], const in
 /* The segments of the nodes of component c (−1: cell centres) of sphere p
  * (box lo..hi from sphere_box) in the grid plane of unwrapped x index ii
  * (cell size h of plane_cell_size()), if that plane is on this rank, that
- * lie within R_eff + band h of its centre (R_eff = R − retraction h): the
+ * lie within R_eff + band h of its centre (R_eff = ibm_forced_radius(R, h)): the
  * grid lines along the run direction (z in 3-D, y in 2-D) through the box,
  * in storage order, each cut to the chord of that ball and split where a
  * periodic face crosses it.  Written to out (room for plane_segments_max())
@@ -214,7 +214,7 @@ static int plane_segments(const ibm_t *ibm, int p, int c, int ii, const int lo[3
     if (il < 0 || il >= g->nxl) return 0;
     double r[3] = {0, 0, 0};
     r[0] = node_coord(g, 0, c, iw) + (ii - iw) / g->n[0] * g->L[0] - s->xa[0];
-    double Rout = s->radius + (band - ibm->prm.retraction) * h, Rout2 = Rout * Rout;
+    double Rout = ibm_forced_radius(ibm, s->radius, h) + band * h, Rout2 = Rout * Rout;
     double xs = s->xa[rd] - g->x0[rd], perp0 = r[0] * r[0];
     if (perp0 >= Rout2) return 0; /* the plane misses the ball */
     if (three) {
@@ -262,14 +262,15 @@ static int plane_segments(const ibm_t *ibm, int p, int c, int ii, const int lo[3
 
 /* ---- node runs ------------------------------------------------------------------ */
 
-/* α of the node at offset r from the centre of a sphere of radius R: the
- * profile of ibm_alpha() (the cell-centre fraction of the snapshots). */
-static inline double alpha_at(double R, double band, double retraction, const double r[3], double h)
+/* α of the node at offset r from the centre of a sphere of forced radius R
+ * (ibm_forced_radius): the profile of ibm_alpha() (the cell-centre fraction
+ * of the snapshots). */
+static inline double alpha_at(double R, double band, const double r[3], double h)
 {
     double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    double Rin = R - (band + retraction) * h;
+    double Rin = R - band * h;
     if (Rin > 0 && r2 <= Rin * Rin) return 1.0;
-    double rr = sqrt(r2), d = rr - R + retraction * h;
+    double rr = sqrt(r2), d = rr - R;
     if (d >= band * h) return 0.0;
     if (d <= -band * h) return 1.0;
     double lam = fabs(r[0] / rr) + fabs(r[1] / rr) + fabs(r[2] / rr);
@@ -279,7 +280,7 @@ static inline double alpha_at(double R, double band, double retraction, const do
 
 /* α of the nodes of consecutive runs of one plane (cell size h), their α
  * contiguous from al: the profile of alpha_at() for a sphere of radius
- * R_eff = R − retraction h.  The nodes are gathered in batches of
+ * R_eff = ibm_forced_radius(R, h).  The nodes are gathered in batches of
  * ALPHA_BATCH (their run coordinate z and their run's constants), so that
  * the two loops of alpha_batch() run over many nodes at a time, whatever
  * the length of the runs (about 10 at D/Δx = 10).  Node k of a run is at
@@ -328,13 +329,13 @@ static void alpha_runs(const ibm_t *ibm, ibm_run_t *runs, long nr, double h, lon
     const ibm_priv_t *q = ibm_priv(ibm);
     double z[ALPHA_BATCH + RUN_SHORT], p2[ALPHA_BATCH + RUN_SHORT], pa[ALPHA_BATCH + RUN_SHORT],
         reff[ALPHA_BATCH + RUN_SHORT], kstep[RUN_SHORT];
-    double step = q->rstep, tscale = alpha_scale / (M_SQRT2 * h), retraction = ibm->prm.retraction;
+    double step = q->rstep, tscale = alpha_scale / (M_SQRT2 * h);
     int rd = q->rdir, e = 0; /* nodes in the batch */
     long ep = 0;             /* nodes of the plane so far */
     for (int k = 0; k < RUN_SHORT; k++) kstep[k] = k * step;
     for (long ir = 0; ir < nr; ir++) {
         ibm_run_t *run = &runs[ir];
-        double P2 = 0.0, PA = 0.0, R = ibm->s[run->p].radius - retraction * h, z0 = run->r0[rd];
+        double P2 = 0.0, PA = 0.0, R = ibm_forced_radius(ibm, ibm->s[run->p].radius, h), z0 = run->r0[rd];
         int len = run->len;
         int32_t u = (int32_t)(run->u0 - n0);
         run->a0 = (int32_t)(a0_first + ep);
@@ -625,7 +626,7 @@ void ibm_solid_fraction_cell(const ibm_t *ibm, double *out)
 {
     const grid_t *g = ibm->g;
     const ibm_priv_t *q = ibm_priv(ibm);
-    double band = ibm_band_halfwidth(), retraction = ibm->prm.retraction;
+    double band = ibm_band_halfwidth();
     ibm_run_t *seg = NULL;
     long cap = 0;
     field_zero(g, out);
@@ -642,7 +643,7 @@ void ibm_solid_fraction_cell(const ibm_t *ibm, double *out)
                 double r[3] = {seg[e].r0[0], seg[e].r0[1], seg[e].r0[2]};
                 for (int k = 0; k < seg[e].len; k++, r[q->rdir] += q->rstep) {
                     long m = seg[e].m0 + k * q->rstride;
-                    double a = out[m] + alpha_at(ibm->s[p].radius, band, retraction, r, h);
+                    double a = out[m] + alpha_at(ibm_forced_radius(ibm, ibm->s[p].radius, h), band, r, h);
                     out[m] = a > 1.0 ? 1.0 : a;
                 }
             }

@@ -39,9 +39,18 @@ static const cfg_key_t ibm_keys[] = {
      "Runge-Kutta stage (stage), or held where the step started and moved between steps, the fluid momentum "
      "over the jump counted in the next force (step: one rebuild per step instead of three, see "
      "docs/theory.md)"},
+    {"ibm", "cn_forcing", CFG_ENUM, "after_solve", 1, 0, "after_solve|predictor",
+     "with the Crank-Nicolson viscous term ([fluid] viscous = implicit, or auto on its implicit steps): the forcing is computed from the Crank-Nicolson solution and applied "
+     "after the solve (after_solve), or from the explicit predictor with the whole viscous term and applied as a "
+     "source term of the implicit solve (predictor: stable and accurate at large Δt ν/Δx², see docs/theory.md "
+     "§4.6); no effect with the explicit viscous term"},
     {"ibm", "retraction", CFG_DOUBLE, "0", -1, 1, NULL,
      "the solid fraction is that of a sphere of radius R - retraction × Δx (cells): compensates the effective "
      "thickening of the forced sphere (0: the seed's method)"},
+    {"ibm", "radius_correction", CFG_ENUM, "none", 1, 0, "none|calibrated",
+     "calibrated: the solid fraction is moreover that of the radius R - (r(κ) - 0.282 Δx/R) Δx, the hydrodynamic "
+     "thickening of the band measured on Stokes flow through sphere arrays (needs forcing_time in [0.1, 0.3] and "
+     "forcing_iterations = 0; see docs/theory.md); none: the seed's volume fraction"},
     {"ibm", "spheres_file", CFG_STRING, NULL, 1, 0, NULL,
      "many spheres: a CSV file (header with x,y,z,radius or diameter; optional density,u,v,w,ox,oy,oz,kind or "
      "fixed) or an HDF5 packing (.h5: datasets position [n][3], radius; optional density, velocity, omega, fixed)"},
@@ -62,6 +71,31 @@ ibm_params_t ibm_default_params(void)
     p.force_model = IBM_FORCE_MOMENTUM;
     p.virtual_mass = 0.1;
     return p;
+}
+
+/* The hydrodynamic radius of a sphere forced with the smoothed indicator of
+ * radius R and forcing_time κ exceeds R by (r(κ) − 0.282 h/R) h, measured on
+ * Stokes flow through the simple cubic array (c = 0.064, D/Δx = 7.9–23.8:
+ * the K of each run gives the radius a_h of Sangani & Acrivos' K(c) for the
+ * same drag; docs/theory.md §6b): r(κ) at κ = 0.1, 0.15, …, 0.3 from the
+ * runs at D/Δx = 11.9 and 15.9, interpolated linearly.  Below D/Δx = 4
+ * (h/R > 0.5, far outside the calibration) the term of D/Δx = 4 is kept, so
+ * that the forced band stays within the margin of sphere_box(). */
+double ibm_calibrated_retraction(double kappa, double h_over_R)
+{
+    if (h_over_R > 0.5) h_over_R = 0.5;
+    static const double r_of_kappa[5] = {0.3135, 0.1903, 0.1027, 0.0335, -0.0229};
+    double x = (kappa - 0.1) / 0.05;
+    int i = x < 0 ? 0 : (x >= 4 ? 3 : (int)x);
+    double w = x - i;
+    return (1 - w) * r_of_kappa[i] + w * r_of_kappa[i + 1] - 0.282 * h_over_R;
+}
+
+double ibm_forced_radius(const ibm_t *ibm, double R, double h)
+{
+    double r = ibm->prm.retraction;
+    if (ibm->prm.radius_calibrated) r += ibm_calibrated_retraction(ibm->prm.forcing_time, h / R);
+    return R - r * h;
 }
 
 /* ---- sphere properties --------------------------------------------------------- */
@@ -179,6 +213,8 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
     if (f->stage_begin_hook || f->plane_hook || f->stage_hook || f->stage_end_hook)
         die("immersed boundary: the fluid's stage hooks are already in use");
     if (g->nalloc >= INT32_MAX) die("immersed boundary: a field of %ld values is too large for the node lists", g->nalloc);
+    if (prm->forcing_predictor && prm->forcing_iterations > 0 && f->prm.implicit_viscous)
+        die("immersed boundary: forcing iterations act after the Crank-Nicolson solve, not with the predictor forcing");
     for (int d = 0; d < g->dim; d++)
         if (g->periodic[d] && g->n[d] > 127 * 1000000) die("immersed boundary: grid too large");
     ibm_t *ibm = xcalloc(1, sizeof *ibm);
@@ -581,7 +617,18 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
     cfg_vec3(cfg, "ibm", "gravity", prm.gravity);
     prm.retraction = cfg_double(cfg, "ibm", "retraction");
     prm.forcing_time = cfg_double(cfg, "ibm", "forcing_time");
+    prm.radius_calibrated = cfg_enum(cfg, "ibm", "radius_correction");
+    if (prm.radius_calibrated && !(prm.forcing_time >= 0.1 && prm.forcing_time <= 0.3))
+        cfg_fail(cfg, "ibm", "radius_correction",
+                 "calibrated needs forcing_time in [0.1, 0.3] (the range of the calibration), not %g",
+                 prm.forcing_time);
+    if (prm.radius_calibrated && prm.forcing_iterations > 0)
+        cfg_fail(cfg, "ibm", "radius_correction", "calibrated needs forcing_iterations = 0 (the calibrated forcing)");
     prm.free_alpha_per_step = cfg_enum(cfg, "ibm", "free_alpha");
+    prm.forcing_predictor = cfg_enum(cfg, "ibm", "cn_forcing") == 1;
+    if (prm.forcing_predictor && prm.forcing_iterations > 0 && f->prm.implicit_viscous)
+        cfg_fail(cfg, "ibm", "forcing_iterations",
+                 "the forcing iterations (project, force) act after the solve: not with cn_forcing = predictor");
     if (g->geom == GEOM_AXI && (prm.gravity[0] != 0.0 || prm.gravity[2] != 0.0))
         cfg_fail(cfg, "ibm", "gravity", "an axisymmetric gravity must be axial (y)");
     if (g->dim == 2 && prm.gravity[2] != 0.0) cfg_fail(cfg, "ibm", "gravity", "a 2-D grid has no z direction");
