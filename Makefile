@@ -6,7 +6,11 @@
 #   make restitution  restitution sweeps (wall and binary; about 15 min on 2 cores);
 #                   RESTITUTION_SET='section.key=value ...' overrides keys in every run,
 #                   RESTITUTION_OUT=dir the output directory (default build/restitution)
+#   make viscous_stability  the stability map of the coupled step at large viscous numbers
+#                   (build/viscous_stability/map.md; ~25 min on 2 cores)
 #   make bounce     the bouncing sphere against experiments, lubrication cut-off, oblique bounces (FULL=1: finer)
+#   make fuzz       the long fuzz series of tests/fuzz.py (40 check and 8 run mutants of every case file;
+#                   FUZZ_SEED=N other mutants, FUZZ_ARGS='--checks 200' more); make test runs a quick subset
 #   make bench      benchmarks, results appended to docs/performance.md
 #   make deps       install missing Debian packages (apt-get)
 #   SANITIZE=1      build with AddressSanitizer + UBSan into build-san/
@@ -24,7 +28,7 @@ BUILD   ?= build
 OPT     := -O3 -march=native -g
 endif
 CFLAGS  := $(STD) $(OPT) $(WARN) -Iinclude $(HDF5_CFLAGS) $(EXTRA_CFLAGS)
-LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -linih -lgsl -lgslcblas -lqhull_r -lcholmod -lsuitesparseconfig \
+LDLIBS  := $(HDF5_LIBS) -lfftw3_mpi -lfftw3 -lgsl -lgslcblas -lqhull_r -lcholmod -lsuitesparseconfig \
            -lgmp -lmpfr -lstdc++ -lm -fopenmp
 # C++ (CGAL's regular triangulation, src/porenet/regular_cgal.cpp): interval
 # arithmetic of the exact predicates needs -frounding-math
@@ -41,7 +45,7 @@ BIN     := $(BUILD)/ibmdem
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 BENCHES := $(patsubst bench/%.c,$(BUILD)/bench/%,$(wildcard bench/bench_*.c))
 
-.PHONY: all test demo validate bench deps clean restitution bounce
+.PHONY: all test demo validate bench deps clean restitution viscous_stability bounce fuzz
 all: $(BIN) $(TESTS) $(BENCHES)
 
 $(BUILD)/obj/%.o: src/%.c
@@ -104,11 +108,22 @@ restitution: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bash scripts/restitution.sh $(RESTITUTION_OUT) full $(RESTITUTION_SET)
 
+# the stability map of the coupled step at large viscous numbers (docs/theory.md §4.6, §9.1):
+# build/viscous_stability/map.md
+viscous_stability: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bash scripts/viscous_stability.sh $(BUILD)/viscous_stability
 # the bouncing sphere against the experiments of Gondret et al. (2002), the lubrication cut-off and the
 # oblique bounces (part of make validate); FULL=1 adds D/dx = 40 (and 30 at St 152): about 3 hours
 bounce: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) OUT=$(BUILD)/bounce FULL=$(FULL) bash scripts/validate_bounce.sh
+
+# mutated case files through check and a few steps of run, clean outcomes only (part of make validate)
+FUZZ_SEED ?= 17
+fuzz: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	@/usr/bin/python3 tests/fuzz.py --bin $(BIN) --seed $(FUZZ_SEED) --checks 40 --runs 8 $(FUZZ_ARGS)
 
 clean:
 	rm -rf build build-san

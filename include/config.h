@@ -1,6 +1,7 @@
 /* config.h — case-file reader with a schema of every key.
  *
- * A case file is an INI file ([section] then key = value).  Every key that a
+ * A case file is an INI file ([section] then key = value, comments after ;
+ * or #), UTF-8 text with lines of any length.  Every key that a
  * module understands is declared once in a schema table (cfg_key_t) with its
  * type, default, range and help text; the schema is what `ibmdem check`
  * prints and what docs/user-guide.md lists.  Unknown keys, wrong types and
@@ -60,6 +61,14 @@ void cfg_vec3(cfg_t *c, const char *section, const char *key, double v[3]);
  * file, so every rank reaches the same error; only rank 0 prints. */
 void cfg_fail(const cfg_t *c, const char *section, const char *key, const char *fmt, ...)
     __attribute__((format(printf, 4, 5), noreturn));
+
+/* A real number as the case file writes it: decimal notation with an
+ * optional exponent (1, -2.5, 3e-4), finite; no hexadecimal, inf or nan.
+ * Leading and trailing blanks are allowed.  Returns 1 and sets *v if s is one. */
+int cfg_parse_real(const char *s, double *v);
+/* Bytes of the valid UTF-8 character at s (n bytes available), 0 if the
+ * bytes there are not UTF-8 (overlong forms and surrogates included). */
+size_t cfg_utf8_char(const char *s, size_t n);
 
 /* Error handling mode: by default cfg_fail exits with status 2.  Tests can
  * install a hook (e.g. a longjmp) that is called with the message instead. */

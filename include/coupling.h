@@ -74,6 +74,30 @@ void coupling_added_mass_after_step(coupling_added_mass_t *am, const dem_t *d);
  * added-mass correction am (NULL: none). */
 void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const double gravity[3],
                             coupling_freeze_t *fz, coupling_added_mass_t *am, double dt);
+/* The hydrodynamic force linearised in the particle's velocity inside the
+ * DEM sub-steps ([coupling] implicit_drag = K, docs/theory.md §9.1): the held
+ * force and torque F_h, T_h were measured with the particle moving at U_n,
+ * ω_n (its velocity at the start of the fluid step); over the sub-steps the
+ * DEM adds −c (U − U_n) and −c_r (ω − ω_n), c = K 3πηD, c_r = K πηD³, so the
+ * drag responds to the velocity the particle gains within the step instead of
+ * one step later.  The terms vanish when the velocity does not change (steady
+ * states unchanged).  They are updated in chunks of DEM steps short against
+ * the relaxation times m/c and I/c_r (at most 5 % of them). */
+typedef struct {
+    int n;          /* spheres (0: off) */
+    double k;       /* K */
+    double mu;      /* dynamic viscosity η of the fluid */
+    double *held;   /* 6n: the held force and torque of this step (by sphere) */
+    long chunks;    /* DEM chunks done (statistics) */
+} coupling_drag_t;
+void coupling_drag_init(coupling_drag_t *dr, int n, double k, double mu);
+void coupling_drag_free(coupling_drag_t *dr);
+/* Advance the DEM by dt after coupling_forces_to_dem (its external force and
+ * torque are the held ones), the linear terms about the spheres' velocities
+ * u, ω (the fluid step's) updated between chunks; am (or NULL): the
+ * velocity change the terms give is added to am->slow (not a collision's). */
+dem_status_t coupling_drag_advance(coupling_drag_t *dr, const ibm_t *ibm, dem_t *d, coupling_added_mass_t *am,
+                                   double dt);
 /* Step 2 → 3: positions and velocities of the particles to the spheres, and
  * the solid fraction rebuilt (collective). */
 void coupling_motion_to_ibm(const dem_t *d, ibm_t *ibm);

@@ -73,6 +73,14 @@ void dem_set_omega(dem_t *d, long id, const double w[3]);
 
 /* One time step of size dem_dt(). */
 dem_status_t dem_step(dem_t *d);
+/* A copy of the whole state (particles, forces, contact springs, pair and
+ * wall lists, walls, time and step): dem_state_save fills `st` (NULL: a new
+ * one, which dem_state_free releases), dem_state_restore brings it back
+ * bit for bit (a diverged step undone: time.rollback). */
+typedef struct dem_state dem_state_t;
+dem_state_t *dem_state_save(const dem_t *d, dem_state_t *st);
+void dem_state_restore(dem_t *d, const dem_state_t *st);
+void dem_state_free(dem_state_t *st);
 /* Advance to t_target with equal steps no longer than dem_dt() (sub-cycling
  * inside a fluid step).  External forces are held constant. */
 dem_status_t dem_advance(dem_t *d, double t_target);

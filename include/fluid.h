@@ -24,21 +24,33 @@ typedef void (*fluid_stage_hook_t)(fluid_t *f, int stage, double dt_stage, void 
  * velocity u* (the arrays ustar[c], which are not yet f->u inside the sweep)
  * once all its components are written, before the projection: may modify
  * u* at the unknowns of plane i (not its ghosts, not other planes).  Inside the predictor sweep when the fluid can (3-D, explicit
- * viscous term, no quadratic wall ghost: docs/theory.md §1, step 1.1b), so
- * that the plane is still in cache; otherwise plane by plane after the
- * sweep (and the Crank–Nicolson solves).  Either way before the stage hook
- * and with the same result. */
+ * viscous term or FLUID_HOOK_PREDICTOR, no quadratic wall ghost:
+ * docs/theory.md §1, step 1.1b), so that the plane is still in cache;
+ * otherwise plane by plane after the sweep (and the Crank–Nicolson solves,
+ * unless FLUID_HOOK_PREDICTOR).  Either way before the stage hook and with
+ * the same result. */
 typedef void (*fluid_plane_hook_t)(fluid_t *f, double *const ustar[3], int stage, double dt_stage, int i, void *ctx);
 
-/* Promises a hook owner makes in f->hook_flags (what the fluid may then fuse):
+/* Promises a hook owner makes in f->hook_flags (what the fluid may then fuse),
+ * and one request:
  *  FLUID_HOOK_KEEPS_USTAR  the stage hook reads u* but does not change it (the
  *                          divergence of u* may be formed inside the sweep);
  *  FLUID_HOOK_IDLE_UK      in this step, the stage-end hooks of stages 0 and 1
  *                          and the stage-begin hooks of stages 1 and 2 read
  *                          neither u nor p (the corrections of stages 0 and 1
- *                          may be deferred into the next sweep).
+ *                          may be deferred into the next sweep);
+ *  FLUID_HOOK_PREDICTOR    (Crank–Nicolson only) the plane hook is called
+ *                          before the Helmholtz solve, on its right-hand side
+ *                          u* = u^{k−1} + Δt(γH + ζH_old) + αΔt(f − G p) + αΔtν/2 L u^{k−1},
+ *                          with f->pred_u and f->pred_a set, from which the
+ *                          explicit predictor with the whole viscous term,
+ *                          ũ = u* + αΔtν/2 L u^{k−1}, is formed at the nodes
+ *                          the hook forces; what it adds to u* becomes a
+ *                          source term of the solve (the forcing inside the
+ *                          implicit step, docs/theory.md §4.6).  Without it
+ *                          the hook gets the solved u*.
  * The fluid reads them after the stage-begin hook of stage 0, for the step. */
-enum { FLUID_HOOK_KEEPS_USTAR = 1, FLUID_HOOK_IDLE_UK = 2 };
+enum { FLUID_HOOK_KEEPS_USTAR = 1, FLUID_HOOK_IDLE_UK = 2, FLUID_HOOK_PREDICTOR = 4 };
 
 /* Coefficients of the low-storage RK3 (step.c): stage k advances by
  * (γ_k + ζ_k) Δt, i.e. to t + (8/15, 2/3, 1) Δt. */
@@ -100,6 +112,11 @@ struct fluid {
     fluid_stage_hook_t stage_end_hook;   /* after each projection (may be NULL) */
     void *hook_ctx;                      /* passed to all hooks */
     int hook_flags;                      /* FLUID_HOOK_* */
+    /* FLUID_HOOK_PREDICTOR, for the plane hook: u^{k−1} of the stage and
+     * a = α_kΔtν/2, so that the explicit predictor at a node m of component
+     * c and local x plane i is ũ = u*[m] + a fluid_laplacian_at(f, c, pred_u[c], i, m) */
+    const double *pred_u[3];
+    double pred_a;
     int implicit_step;    /* the viscous term of the current (or last) step is Crank–Nicolson */
     long implicit_steps;  /* steps taken with it (viscous = auto: the others were explicit) */
     double dt_viscous;    /* the explicit viscous limit (fourier target; INFINITY without viscosity) */
@@ -147,6 +164,10 @@ double fluid_max_divergence(const fluid_t *f);
  *  fluid_divergence: D u at the cell centres. */
 void fluid_advection(const fluid_t *f, double *const out[3]);
 void fluid_viscous(const fluid_t *f, double *const out[3]);
+/* (L u)_m of component c at the unknown m of local x plane i, the operator of
+ * fluid_viscous at one node (moving walls and quadratic wall ghosts included;
+ * without the factor ν); u with valid ghosts. */
+double fluid_laplacian_at(const fluid_t *f, int c, const double *u, int i, long m);
 void fluid_divergence(const fluid_t *f, double *div);
 /* Volume of the control cell of the unknown (i,j,k) of component c (local i;
  * axisymmetric: per radian); the weight of the discrete energy Σ V u². */

@@ -22,7 +22,9 @@
  *     u ← u + β (U − u)      (f = β (U − u*)/Δt_k),
  * with α the smoothed solid fraction of decision 1 at each staggered node
  * and β = α (the seed's forcing) or its time-step independent form
- * β = α Δt_k/((1 − α)τ + α Δt_k) (forcing.c);
+ * β = α Δt_k/((1 − α)τ + α Δt_k) (forcing.c); with the Crank–Nicolson
+ * viscous term either after the implicit solve (cn_forcing = after_solve) or,
+ * from the explicit predictor, as a source term of it (predictor);
  * after the projection the momentum integrals are taken and the spheres are
  * moved.  Geometries: 3-D (spheres), 2-D (discs, per unit depth) and
  * axisymmetric (spheres on the axis, moving along it, integrals with 2πr).
@@ -91,6 +93,9 @@ typedef struct {
                            * τ = κ h²/ν (0: the seed's u ← u + α (U − u) at every stage) */
     int free_alpha_per_step; /* 1: a free sphere's α is held over the fluid step and moved
                               * between steps (docs/theory.md §6b); 0: moved after every stage */
+    int forcing_predictor; /* Crank–Nicolson: 1: forcing of the explicit predictor, a source term of
+                            * the implicit solve (FLUID_HOOK_PREDICTOR, docs/theory.md §4.6);
+                            * 0: forcing of the solved velocity (after the solve) */
 } ibm_params_t;
 
 typedef struct ibm ibm_t;

@@ -28,39 +28,80 @@
 
 typedef struct {
     char dir[IO_PATH_MAX];
-    FILE *log; /* rank 0: DIR/log.txt */
+    FILE *log;   /* rank 0: DIR/log.txt */
+    int lock_fd; /* rank 0: DIR/.ibmdem.lock, held for the run */
 } io_outdir_t;
 
-/* Create DIR and its parents, open DIR/log.txt (appended to when `append`,
- * e.g. on a restart) and send to it everything rank 0 prints with msg, warn
- * and die.  Stops the run (every rank) if DIR cannot be created. */
-void io_outdir_open(io_outdir_t *o, const char *dir, int append, MPI_Comm comm);
+/* Open the output folder of a run (collective): create DIR and its parents,
+ * take its lock (one run at a time in a folder), and for a new run (restart
+ * = 0) check that it holds no output of an earlier run — the files ibmdem
+ * writes, and the names of `extra` (NULL-terminated, may be NULL) — or
+ * delete those (overwrite); open DIR/log.txt (appended to on a restart) and send to it
+ * everything rank 0 prints with msg, warn and die.  Returns 0, or on every
+ * rank 2 (refused: another run holds the folder, earlier outputs, a path the
+ * system refuses) or 1 (a system error), with the reason in why. */
+int io_outdir_open(io_outdir_t *o, const char *dir, int restart, int overwrite, const char *const *extra, char *why,
+                   size_t nwhy, MPI_Comm comm);
 /* "DIR/name" into buf. */
 void io_outdir_path(const io_outdir_t *o, const char *name, char *buf, size_t n);
 /* Rank 0: DIR/input.ini = the resolved input (cfg_write_resolved). */
 void io_outdir_write_input(const io_outdir_t *o, const cfg_t *cfg);
+/* Rank 0: delete DIR/<prefix><number><suffix> for every number >= first
+ * (on a restart, the files the lost continuation wrote after the checkpoint). */
+void io_outdir_remove_numbered(const io_outdir_t *o, const char *prefix, const char *suffix, long first);
+/* Collective: 1 on every rank if any rank recorded an I/O error (io_error,
+ * util.h), with its message in why; 0 otherwise. */
+int io_check_errors(MPI_Comm comm, char *why, size_t nwhy);
+/* Close the log and release the lock. */
 void io_outdir_close(io_outdir_t *o);
 
 /* ---- time series (series.c) ---------------------------------------------- */
 
 typedef struct io_series io_series_t;
 
-/* Rank 0 writes PATH, a CSV file with a header line of the `ncol` column
- * names; column 0 must be "step".  restart_step < 0: a new file.  Otherwise
- * the rows of an existing PATH with step <= restart_step are kept (a run
- * restarted from a checkpoint continues the series without duplicates). */
-io_series_t *io_series_open(const char *path, int ncol, const char *const *names, long restart_step);
+/* A restart's record of a series (from the checkpoint): the restart step,
+ * the step of the last row before the checkpoint (-1: none) and the hash of
+ * the file up to that row (has_hash = 0: not known). */
+typedef struct {
+    long step, last_row;
+    uint64_t hash;
+    int has_hash;
+} io_series_resume_t;
+
+/* Collective; rank 0 writes PATH, a CSV file with a header line of the `ncol`
+ * column names; column 0 must be "step".  r == NULL: a new file.  Otherwise
+ * (a restart) the existing PATH is continued: its rows with step <= r->step
+ * are kept, and must be exactly those the run had written when it wrote the
+ * checkpoint (the last one of step r->last_row, the hash r->hash); the rest
+ * (the lost continuation, a row cut by a crash) is cut off.  A file with
+ * other columns or other rows stops the run; a missing file starts anew
+ * (with a warning). */
+io_series_t *io_series_open(const char *path, int ncol, const char *const *names, const io_series_resume_t *r);
 /* Rank 0: one row of ncol values (integers are written without decimals). */
 void io_series_row(io_series_t *s, const double *values);
+/* Step of the last row written (-1: none). */
+long io_series_last_step(const io_series_t *s);
+/* Rank 0: hash of the file up to its last row of step <= `step` (the rows a
+ * checkpoint of that step follows: the last step's, or those before it). */
+uint64_t io_series_hash(const io_series_t *s, long step);
+/* Rank 0: flush and fsync every open series (before a checkpoint). */
+void io_series_sync_all(void);
 void io_series_close(io_series_t *s);
 
 /* ---- parallel HDF5 (h5.c) -------------------------------------------------- */
 
 /* Create (truncate) / open read-only an HDF5 file with the MPI-IO driver.
- * io_h5_create stops the run on failure; io_h5_open returns a negative id. */
+ * io_h5_create stops the run on failure; io_h5_open returns a negative id.
+ * The writers below record a failed write as an I/O error (io_error) and
+ * go on, so that every rank makes the same collective calls. */
 hid_t io_h5_create(const char *path, MPI_Comm comm);
 hid_t io_h5_open(const char *path, MPI_Comm comm);
+/* Close; a file opened for writing is first flushed to the disk (fsync). */
 void io_h5_close(hid_t file);
+/* Collective: 1 if a floating-point dataset of the file holds a NaN or an
+ * infinity (its path, e.g. "/fluid/u", into where), else 0.  Each rank reads
+ * a share of every dataset. */
+int io_h5_check_finite(hid_t file, MPI_Comm comm, char *where, size_t n);
 
 /* The interior of a grid field (i = 0..nx-1, j = 0..ny-1, k = 0..nz-1, no
  * ghosts) as dataset `name` of shape [nx][ny][nz] — the memory order, k
@@ -98,6 +139,9 @@ void io_h5_attr_string(hid_t loc, const char *name, const char *v);
 /* Return 0, or -1 if the attribute is missing. */
 int io_h5_get_attr_double(hid_t loc, const char *name, double *v);
 int io_h5_get_attr_long(hid_t loc, const char *name, long *v);
+/* A 64-bit hash known to rank 0 (sent to the others), as 16 hex digits. */
+void io_h5_attr_hash(hid_t loc, const char *name, uint64_t h, MPI_Comm comm);
+int io_h5_get_attr_hash(hid_t loc, const char *name, uint64_t *h);
 
 /* ---- field snapshots + XDMF (snapshot.c) ------------------------------------- */
 
@@ -122,6 +166,8 @@ void io_snapshot_face_vector(io_snapshots_t *s, const char *name, double *const 
  * whenever the run stops. */
 void io_snapshot_end(io_snapshots_t *s);
 int io_snapshots_count(const io_snapshots_t *s);
+/* Rank 0: rewrite DIR/fields.xmf now (a restart: the snapshots before `first`). */
+void io_snapshots_write_index(const io_snapshots_t *s);
 void io_snapshots_free(io_snapshots_t *s);
 
 /* ---- checkpoints (checkpoint.c) ---------------------------------------------- */
@@ -140,13 +186,20 @@ typedef struct {
  * and renamed by io_checkpoint_end, so a run killed while writing leaves the
  * previous checkpoint intact.  The header goes in root attributes. */
 hid_t io_checkpoint_begin(const char *dir, const io_checkpoint_header_t *h, MPI_Comm comm);
-/* Close, rename; path of the final file into `path` (may be NULL); rank 0
- * then deletes the oldest checkpoint_*.h5 of DIR beyond the `keep` newest
- * (keep <= 0: keep all). */
-void io_checkpoint_end(hid_t file, const char *dir, long step, int keep, char *path, size_t npath, MPI_Comm comm);
-/* Open a checkpoint and read its header.  Returns the file (close with
- * io_h5_close), or stops the run with a message naming the file if it cannot
- * be read or is not an ibmdem checkpoint. */
+/* Close (fsync), and if no rank had an I/O error rename it to its final name
+ * and fsync the folder: only then is the checkpoint written (its path into
+ * `path`, may be NULL); rank 0 then deletes the oldest checkpoint_*.h5 of DIR
+ * beyond the `keep` newest (keep <= 0: keep all).  Returns 0, or -1 on every
+ * rank after an I/O error (io_error: the temporary file is deleted, the
+ * previous checkpoint stays the newest). */
+int io_checkpoint_end(hid_t file, const char *dir, long step, int keep, char *path, size_t npath, MPI_Comm comm);
+/* Rank 0: delete the oldest checkpoint_*.h5 of DIR beyond the `keep` newest
+ * (keep <= 0: none). */
+void io_checkpoint_prune(const char *dir, int keep);
+/* Open a checkpoint, read its header and check that every floating-point
+ * dataset is finite.  Returns the file (close with io_h5_close), or stops
+ * the run with a message naming the file (and the dataset) if it cannot be
+ * read, is not an ibmdem checkpoint or holds a NaN or an infinity. */
 hid_t io_checkpoint_open(const char *path, io_checkpoint_header_t *h, MPI_Comm comm);
 void io_checkpoint_header_free(io_checkpoint_header_t *h);
 
@@ -175,7 +228,8 @@ void io_summary_string(io_summary_t *s, const char *key, const char *v);
 void io_summary_double(io_summary_t *s, const char *key, double v);
 void io_summary_long(io_summary_t *s, const char *key, long v);
 void io_summary_bool(io_summary_t *s, const char *key, int v);
-/* Rank 0: write the JSON object to PATH; returns 0 or -1. */
+/* Rank 0: write the JSON object to PATH (whole or not at all: a temporary
+ * file renamed); returns 0, or -1 after io_error. */
 int io_summary_write(const io_summary_t *s, const char *path);
 void io_summary_free(io_summary_t *s);
 

@@ -224,10 +224,10 @@ typedef struct {
     pn_solver_t *sol;
     int built;
     double *p, *vol, *vol_prev, *dvdt, *x_prev;
-    double *x_tri;      /* positions the current triangulation and network were built for (checkpoints) */
     int vol_current;    /* vol holds the pore volumes at x_prev on the current topology (the next step's start) */
     double *f, *fp, *fv; /* fp, fv: filled by pn_write_snapshot only */
     double *x_cont;     /* previous positions continuous with the current ones (periodic unwrapping) */
+    double *x_tri;      /* 3n: the positions the current triangulation was built from (exact restarts) */
     double *xid, *rid;  /* DEM coupling: positions / radii in the order of the particle ids (couple.c) */
     double dt_factor;   /* ζ of the coupled time step (thesis 4.21) */
     int dem_steps;      /* DEM steps per coupled step (multi-rate), within ζ Δt_{M−V} */
@@ -315,5 +315,7 @@ int pn_model_validity(const pn_model_t *m, const double *r, char *buf, size_t nb
  * tetrahedra are those of the pores, the halves of the wall pores outside the
  * box included (each carries its pore's pressure). */
 void pn_write_snapshot(pn_model_t *m, const double *x, const char *dir, double time);
+/* Rank 0: rewrite DIR/porenet.xmf for the snapshots listed in m (a restart). */
+void pn_write_index(const pn_model_t *m, const char *dir);
 
 #endif

@@ -16,7 +16,10 @@
  *   dt = min over parts of stable_dt      (fluid_stable_dt)
  *   every part: advance(dt)              (fluid_step)
  *   diagnostics; stop with a checkpoint if a part reports divergence
- *   outputs due at this step (series, fields, checkpoint), progress line
+ *   outputs due at this step (series, fields, checkpoint), progress line;
+ *   stop with a checkpoint if a write failed (io_check_errors)
+ * What the outputs promise (durability, restarts, the output folder) is in
+ * docs/user-guide.md, "What the outputs promise".
  */
 #ifndef IBMDEM_SIM_H
 #define IBMDEM_SIM_H
@@ -50,8 +53,11 @@ typedef struct sim_part {
     /* After a step: non-zero with a reason if the state is unusable (non-finite
      * values, a stability limit exceeded, a blow-up). */
     int (*diverged)(void *ctx, char *why, size_t nwhy);
-    /* Keep / bring back the state at the start of the step (so a diverged
-     * run checkpoints the last good state); NULL if the part cannot. */
+    /* Keep / bring back the state at the start of the step, exactly (so a
+     * diverged run checkpoints its last good state, from which a restart
+     * continues as the uninterrupted run did).  A part with a checkpoint
+     * (checkpoint_write) must have them: without, a diverged run checkpoints
+     * the state after the failed step. */
     void (*keep_previous)(void *ctx);
     void (*restore_previous)(void *ctx);
     /* Relative rate of change over the last step, per unit time (for
@@ -67,6 +73,10 @@ typedef struct sim_part {
     /* Non-zero when the part has what the run was for (e.g. a measured
      * bounce): the run stops as at t_end.  NULL: never. */
     int (*done)(void *ctx);
+    /* Non-zero with a reason when the part cannot go on from the state it is
+     * in though nothing diverged (e.g. a contact it has no law for): the run
+     * stops with its final outputs, the reason and exit status 1.  NULL: never. */
+    int (*halt)(void *ctx, char *why, size_t nwhy);
     void (*destroy)(void *ctx);
 } sim_part_t;
 
@@ -85,6 +95,7 @@ typedef struct {
     long series_every;     /* steps between rows of the time series */
     long checkpoint_every; /* steps between checkpoints (0: at the end only) */
     int checkpoint_keep;   /* checkpoints kept in the folder (0: all) */
+    int overwrite;         /* a new run deletes the outputs of an earlier run in the folder (else refused) */
     int progress;          /* progress line: 0 auto, 1 on, 2 off (io_progress_start) */
 } sim_params_t;
 
@@ -93,7 +104,17 @@ typedef struct {
  * io_snapshot_end of every snapshot. */
 typedef void (*sim_field_writer_t)(void *ctx, io_snapshots_t *snap);
 
-typedef enum { SIM_RUNNING = 0, SIM_T_END, SIM_MAX_STEPS, SIM_WALL_LIMIT, SIM_STEADY, SIM_DIVERGED, SIM_DONE } sim_status_t;
+typedef enum {
+    SIM_RUNNING = 0,
+    SIM_T_END,
+    SIM_MAX_STEPS,
+    SIM_WALL_LIMIT,
+    SIM_STEADY,
+    SIM_DIVERGED,
+    SIM_DONE,
+    SIM_HALTED,
+    SIM_IO_ERROR
+} sim_status_t;
 
 struct sim {
     cfg_t *cfg;
@@ -105,15 +126,20 @@ struct sim {
     sim_field_writer_t field_writer[SIM_MAX_PARTS]; /* extra fields of the fluid snapshots */
     void *field_writer_ctx[SIM_MAX_PARTS];
     int nfield_writers;
+    const char *output_names[SIM_MAX_PARTS + 1]; /* files of the parts beyond the usual ones (NULL-terminated) */
+    int noutput_names;
     /* state */
     double time, dt;
     long step;
-    double time_prev;        /* time and step at the start of the last step */
+    double time_prev;        /* time, step and dt at the start of the last step */
     long step_prev;
+    double dt_prev;
     double wall0, wall_step; /* start of the run; wall time of the last step */
     long step0;              /* step at the start of this run (restart) */
     sim_status_t status;
-    char why[512];           /* why the run diverged */
+    char why[512];           /* why the run diverged or halted */
+    char io_why[IO_PATH_MAX + 512]; /* the write that failed */
+    char *command;           /* the command line of the run, quoted, without --restart (sim_set_command) */
     /* outputs */
     io_outdir_t out;
     io_series_t *series;
@@ -121,6 +147,8 @@ struct sim {
     io_progress_t progress;
     double next_fields;      /* simulated time of the next snapshot */
     long last_fields_step, last_series_step, last_checkpoint_step;
+    long prev_series_step;   /* the series row before the last one */
+    io_series_resume_t series_resume; /* restart: what the checkpoint says of series.csv */
     double next_report;      /* progress fraction of the next report line */
     char last_checkpoint[IO_PATH_MAX + 64];
     char restart_path[IO_PATH_MAX];
@@ -142,15 +170,30 @@ void sim_build_scene(sim_t *s, cfg_t *cfg);
 void sim_note_unused(const sim_t *s);
 /* Add a part (called from sim_create). */
 void sim_add_part(sim_t *s, const sim_part_t *part);
+/* The command line that started the run (argv of main), for the advice
+ * printed when it stops early (restart commands that work as printed). */
+void sim_set_command(sim_t *s, int argc, char **argv);
 /* Run to the end; returns the exit status: 0 when the run finished (t_end,
- * max_steps, steady state or wall_limit), 3 when it diverged. */
+ * max_steps, steady state or wall_limit), 1 when a part halted it or a write
+ * failed, 3 when it diverged. */
 int sim_run(sim_t *s);
+/* A word for a POSIX shell: as it is, or single-quoted. */
+void shell_quote(const char *word, char *buf, size_t n);
+/* The command that continues the run from checkpoint `ckpt` (sim_advice.c). */
+void sim_restart_command(const sim_t *s, const char *ckpt, char *buf, size_t n);
+/* "--set KEY=VALUE": a smaller step for the part that diverged (s->why). */
+void sim_smaller_step_hint(const sim_t *s, char *buf, size_t n);
 void sim_free(sim_t *s);
 
 /* The keys a restart may change without breaking exactness (the fingerprint
  * skips them): run control, outputs, and the FFTW wisdom file (a restart
  * plans from the checkpoint's copy of the wisdom). */
 extern const char *const sim_run_control_keys[];
+
+/* A file a part writes into the output folder under a name of the case
+ * file's (e.g. [packing] output): an output of the run, like the usual ones
+ * (a new run refuses a folder that has it, output.overwrite deletes it). */
+void sim_add_output_name(sim_t *s, const char *name);
 
 /* Add cell fields to the fluid's snapshots (see sim_field_writer_t). */
 void sim_add_field_writer(sim_t *s, sim_field_writer_t fn, void *ctx);

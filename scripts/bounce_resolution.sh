@@ -17,6 +17,7 @@ echo "d_over_dx,nx,ny,steps,wall_s,V_T,V_C_over_V_T,epsilon,epsilon_over_max,St,
 for N in $LIST; do
     nu=$(( 5 * N / 2 )); nx=$(( 4 * N )); ny=$(( 44 * N ))
     d=$OUT/n$N
+    rm -rf "$d"
     "$ROOT/build/ibmdem" run "$ROOT/cases/bouncing_sphere/bounce_axi.ini" --out "$d" \
         --set domain.nx=$nx --set domain.ny=$ny --set domain.x_uniform_cells=$nu \
         --set lubrication.model=$LUB --set coupling.stop_after_rebound=true \

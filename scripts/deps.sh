@@ -3,7 +3,7 @@
 # DEPS_PKGS replaces the list (bench/deps_bench.sh: the codes the benchmarks compare with).
 set -e
 PKGS=${DEPS_PKGS:-"make gcc g++ pkg-config libopenmpi-dev openmpi-bin libfftw3-dev libfftw3-mpi-dev libhdf5-openmpi-dev
-      hdf5-tools libgsl-dev libinih-dev libcmocka-dev libqhull-dev libcgal-dev libsuitesparse-dev libopenblas0-serial
+      hdf5-tools libgsl-dev libcmocka-dev libqhull-dev libcgal-dev libsuitesparse-dev libopenblas0-serial
       python3-numpy python3-matplotlib python3-h5py"}
 missing=""
 for p in $PKGS; do

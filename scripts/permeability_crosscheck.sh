@@ -24,6 +24,7 @@ CASE=cases/permeability_crosscheck
 mkdir -p "$OUT"
 status=0
 
+rm -rf "$OUT/porenet"
 "$BUILD/ibmdem" run $CASE/porenet.ini --out "$OUT/porenet" >"$OUT/porenet.log" 2>&1 || { echo "porenet run failed"; exit 1; }
 dirs=""
 for n in $NX_LIST; do

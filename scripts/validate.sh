@@ -174,6 +174,22 @@ BUILD=$BUILD OUT=$OUT bash scripts/validate_bounce.sh || fail "coupling bounce a
 section "permeability: resolved solver against the pore network on the same packing (issue 6)"
 BUILD=$BUILD OUT=$OUT bash scripts/permeability_crosscheck.sh || fail "permeability cross-check"
 
+# --- input: the long fuzz series (tests/fuzz.py; make test runs 1 check and 1 run mutant of
+# each case file): 40 check and 8 run mutants of every case file in cases/, clean outcomes only
+# (exit 0 with finite output, exit 2 naming the file and line, a clean divergence or halt; never
+# a signal, a sanitizer report or a hang).  FUZZ_SEED=N draws other mutants.
+section "input: fuzzed case files (40 check and 8 run mutants per case file)"
+/usr/bin/python3 tests/fuzz.py --bin "$BUILD/ibmdem" --seed "${FUZZ_SEED:-17}" --checks 40 --runs 8 || fail "fuzz"
+
+# --- outputs: runs killed at random moments (12 per case) and at the chosen points of the
+# checkpoint write, on 1 and 2 ranks, restarted from their newest checkpoint until they end:
+# every output identical to the uninterrupted run's (tests/kill_test.sh in its long mode;
+# make test runs 7 kills on 1 rank).
+section "outputs: killed and restarted runs leave the uninterrupted run's files (1 and 2 ranks)"
+KILL_TEST=long BUILD=$BUILD bash tests/kill_test.sh | tee "$OUT/kill_test.txt" | grep -v '^ok' || true
+grep -q '^not ok' "$OUT/kill_test.txt" && fail "kill test"
+echo "  $(grep -c '^ok' "$OUT/kill_test.txt") passed, $(grep -c '^not ok' "$OUT/kill_test.txt") failed"
+
 # (further modules: add sections here)
 
 echo

@@ -24,9 +24,11 @@ INI=cases/bouncing_sphere/bounce_axi.ini
 S="--set coupling.stop_after_rebound=true --set output.progress=off"
 rc=0
 for y in 40 40.004 40.008 40.012; do
+    rm -rf "$OUT/phase_$y"
     "$BUILD/ibmdem" run $INI $S --set particles.particle1=center,0,$y,0,diameter,1,density,8 --out "$OUT/phase_$y" \
         > "$OUT/phase_$y.log" 2>&1 || { echo "run y0=$y failed"; rc=1; }
 done
+rm -rf "$OUT/nolub"
 "$BUILD/ibmdem" run $INI $S --set lubrication.model=none --out "$OUT/nolub" > "$OUT/nolub.log" 2>&1 || { echo "no-lubrication run failed"; rc=1; }
 /usr/bin/python3 - "$OUT" <<'PY'
 import json, statistics, sys
@@ -49,6 +51,7 @@ PY
 [ $? = 0 ] || rc=1
 bash scripts/bounce_resolution.sh "$OUT/bounce_resolution" 8 10 14 20 28 40 || rc=1
 /usr/bin/python3 postproc/bounce_resolution.py "$OUT/bounce_resolution/resolution.csv" "$OUT/bounce_resolution/resolution.png" || rc=1
+rm -rf "$OUT/bounce3d"
 mpirun --allow-run-as-root --oversubscribe -np 2 "$BUILD/ibmdem" run cases/bouncing_sphere/bounce_3d.ini $S --out "$OUT/bounce3d" \
     > "$OUT/bounce3d.log" 2>&1 || { echo "3-D run failed"; rc=1; }
 /usr/bin/python3 -c "
@@ -57,6 +60,7 @@ print(f\"  3-D D/dx = 10: V_T {c['V_T']:.4f}  eps/eps_max {c['epsilon_over_max']
 # 5. Table 3.2 points (two runs at a time, one rank each)
 for v in "1e-5 0.5" "2e-4 0.5" "1e-3 0.5" "2e-4 1"; do
     set -- $v
+    rm -rf "$OUT/t32_$1_$2"
     "$BUILD/ibmdem" run $INI $S --set lubrication.roughness=$1 --set lubrication.range=$2 --out "$OUT/t32_$1_$2" \
         > "$OUT/t32_$1_$2.log" 2>&1 &
     [ "$1 $2" = "2e-4 0.5" ] && wait

@@ -100,6 +100,15 @@ static int usage_error(const char *fmt, const char *arg)
 
 int main(int argc, char **argv)
 {
+#ifdef OPEN_MPI
+    /* Open MPI's MPI-IO (OMPIO, under parallel HDF5) asks its shared-file-
+     * pointer components about every file it opens; the "lockedfile" one
+     * copies the file name into a 256-byte buffer, which a path of 245
+     * characters or more overflows (Open MPI 4.1: the process aborts).
+     * ibmdem never uses shared file pointers: that component is left out,
+     * unless the user chose the components (then paths must stay shorter). */
+    setenv("OMPI_MCA_sharedfp", "^lockedfile", 0);
+#endif
     MPI_Init(&argc, &argv);
     modules_register_keys();
     const char *cmd = argc >= 2 ? argv[1] : "";
@@ -146,13 +155,20 @@ int main(int argc, char **argv)
         }
     }
     if (!path) return usage_error("%s: missing CASE.ini", cmd);
-    char outset[IO_PATH_MAX + 16];
+    if (restart && strlen(restart) >= IO_PATH_MAX) {
+        char lim[32];
+        snprintf(lim, sizeof lim, "%d", IO_PATH_MAX - 1);
+        return usage_error("--restart: a path longer than %s bytes", lim);
+    }
+    char *outset = NULL;
     if (out) {
-        snprintf(outset, sizeof outset, "output.dir=%s", out);
+        outset = malloc(strlen(out) + 16);
+        sprintf(outset, "output.dir=%s", out);
         sets[nset++] = outset; /* last: wins over the file and other --set */
     }
 
     cfg_t *cfg = cfg_load(path, nset, sets);
+    free(outset);
     if (!cfg) {
         /* the messages are printed; every rank parsed the same input */
         MPI_Finalize();
@@ -161,6 +177,7 @@ int main(int argc, char **argv)
     sim_t *s = sim_create(cfg, restart, !run);
     int status = 0;
     if (run) {
+        sim_set_command(s, argc, argv);
         status = sim_run(s);
     } else if (mpi_rank() == 0) {
         cfg_write_resolved(cfg, stdout);
@@ -169,6 +186,5 @@ int main(int argc, char **argv)
     sim_free(s);
     cfg_free(cfg);
     free(sets);
-    MPI_Finalize();
-    return status;
+    mpi_finish(status);
 }

@@ -90,6 +90,51 @@ check "unknown option" 2 "unknown option '--frobnicate'" -- $BIN run "$f" --frob
 check "restart from a file that is not a checkpoint" 1 "$f: cannot open the checkpoint" -- \
     $BIN run "$f" --out "$T/o1" --restart "$f"
 
+# The reader: lines of any length, every byte of the file read as written.
+long=$(printf '%0300d' 0)
+# a folder of 301 bytes in two names (a name is at most NAME_MAX = 255 bytes); lps: for sed
+lp=$(printf '%0150d/%0149d' 0 0); lps=${lp//\//\\/}
+f=$(mk long_comment "\$a; $long cfl = 5")
+check "a 300-byte comment line hides no key" 0 "" -- $BIN check "$f"
+f=$(mk long_value "s/^\\[time\\]\$/[output]\\ndir = n$lps\\n[time]/")
+check "a 300-byte value is read whole" 0 "" -- $BIN check "$f"
+grep -q "^dir = n$lp\$" "$T/out"
+report $? "the resolved input holds the whole 301-byte value"
+f=$(mk long_value_line "s/^\\[time\\]\$/[output]\\ndir = n$lps\\nnam = x\\n[time]/")
+check "an error after a long line has its own line number" 2 "^$f:16: output.nam: unknown key\$" -- $BIN check "$f"
+f=$(mk hex 's/^t_end = 0.1$/t_end = 0x10/')
+check "a hexadecimal number is refused" 2 "^$f:15: time.t_end: '0x10' is not a real number" -- $BIN check "$f"
+f=$(mk hex_vec 's/^length = 1 1 1$/length = 0x1 1 1/')
+check "a hexadecimal component is refused" 2 "^$f:5: domain.length: '0x1 1 1' is not three real numbers" -- $BIN check "$f"
+f=$(mk nan 's/^t_end = 0.1$/t_end = nan/')
+check "nan is refused" 2 "^$f:15: time.t_end: 'nan' is not a real number" -- $BIN check "$f"
+f=$(mk latin1 "s/^\\[time\\]\$/[output]\\nname = caf\\xe9\\n[time]/")
+check "a name that is not UTF-8 is refused" 2 "^$f:15: column 11: byte 0xE9 is not UTF-8 text" -- $BIN check "$f"
+check "/dev/zero is not a case file (and check returns)" 2 "^/dev/zero:1: column 1: a NUL byte" -- \
+    timeout 20 $BIN check /dev/zero
+check "a folder is not a case file" 2 "^$T: cannot open: Is a directory\$" -- $BIN check "$T"
+f=$(mk bracket 's/^\[time\]$/[time/')
+check "a header without its ]" 2 "^$f:14: syntax error: '\\[' without '\\]'" -- $BIN check "$f"
+grep -q "unknown" "$T/err"
+[ $? = 1 ]; report $? "the keys under that header are not reported as unknown"
+f=$(mk indented 's/^nu = 0.01$/nu = 0.01\n  cfl = 0.5/')
+check "an indented key" 2 "^$f:14: an indented line" -- $BIN check "$f"
+f=$(mk before_section '1s/^/nu = 1\n/')
+check "a key before the first section" 2 "^$f:1: nu: a key before the first \\[section\\] header" -- $BIN check "$f"
+f=$T/ok.ini
+check "a 600-byte --set value is read whole" 0 "" -- $BIN check "$f" --set "output.dir=n$lp/$lp"
+grep -q "^dir = n$lp/$lp ; --set\$" "$T/out"
+report $? "the resolved input holds the whole --set value"
+check "a name longer than 255 bytes is refused" 2 "^--set output.name: longer than 255 bytes" -- \
+    $BIN run "$f" --set "output.name=n$long" --out "$T/o_name"
+deep=$(printf "$T/%0200d/%0200d/%0200d" 1 2 3)
+# (only input.ini, written first, is looked at: the files after it are the output's own tests)
+(timeout 120 $BIN run "$f" --set time.max_steps=1 --out "$deep" >/dev/null 2>&1; true) 2>/dev/null
+grep -q "^dir = $deep ; --set\$" "$deep/input.ini"
+report $? "--out of 600 bytes makes that folder (its input.ini holds the whole path)"
+check "an output folder longer than the path limit is refused" 2 "^--set output.dir: the path is longer than 4095 bytes" -- \
+    $BIN run "$f" --out "$T/$(printf '%04200d' 0)"
+
 # A diverging run: a fixed time step 16 times the convective limit of the lid
 # (CFL = U dt / dx = 1 x 0.5 x 8 = 4 at the first step, above the hard limit
 # 1.5) must stop with status 3 and a checkpoint of the state it started from.

@@ -821,7 +821,7 @@ static void test_bad_input(void **state)
                       "y_hi = noslip\n[fluid]\nnu = 0.1\nwall_ghost = quadratic\n";
     const char *m = try_text(one);
     msg("  [one cell between walls] -> %s\n", m[0] ? m : "(accepted)");
-    assert_non_null(strstr(m, "case.ini:11: fluid.wall_ghost: quadratic needs at least 2 cells"));
+    assert_non_null(strstr(m, "case.ini:4: domain.ny: at least 2 cells between walls"));
 }
 
 int main(int argc, char **argv)

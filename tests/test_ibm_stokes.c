@@ -55,8 +55,9 @@ static double drag_ratio(int dpd, int n, double fo, double *c_out)
              "[domain]\nnx = %d\nny = %d\nnz = %d\nlength = %.17g %.17g %.17g\n"
              "[fluid]\nnu = %g\nviscous = %s\nbody_force = %.17g 0 0\ndt = %.17g\n"
              "[ibm]\nsphere1 = fixed center %.17g %.17g %.17g radius %g\n"
-             "retraction = %g\nforcing_time = %g\n",
-             n, n, n, L, L, L, nu, getenv("IBM_VISC") ? getenv("IBM_VISC") : "implicit", fH, dt, 0.5 * L, 0.5 * L, 0.5 * L, a, env_double("IBM_RETRACTION", 0.0), env_double("IBM_KAPPA", 0.0));
+             "retraction = %g\nforcing_time = %g\ncn_forcing = %s\n",
+             n, n, n, L, L, L, nu, getenv("IBM_VISC") ? getenv("IBM_VISC") : "implicit", fH, dt, 0.5 * L, 0.5 * L, 0.5 * L, a, env_double("IBM_RETRACTION", 0.0), env_double("IBM_KAPPA", 0.0),
+             getenv("IBM_CNF") ? getenv("IBM_CNF") : "after_solve");
     it_case_t tc = it_from_case(text);
     /* the slowest viscous mode of the box decays as exp(−ν(2π/L)² t) */
     double t_end = env_double("IBM_TDECAY", 5.0) * L * L / (4 * M_PI * M_PI * nu);

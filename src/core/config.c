@@ -1,18 +1,19 @@
-/* config.c — case-file reader (INI via libinih) checked against a schema.
+/* config.c — case-file reader (INI) checked against a schema.
  *
- * libinih calls our handler for each key; we count lines in our own reader
- * callback so every stored value knows its line, which is what makes the
+ * The reader is our own (lines of any length, strict about what is not a
+ * case file: bytes that are not UTF-8 text, indented lines, a '[' without
+ * ']'); every stored value knows its line, which is what makes the
  * `file:line: section.key: reason` messages possible. */
 #include "config.h"
 
 #include <ctype.h>
 #include <errno.h>
-#include <ini.h>
 #include <math.h>
 #include <mpi.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #define MAX_SCHEMA_TABLES 64
 
@@ -70,6 +71,7 @@ struct cfg {
     int n, cap;
     int nerr;
     int line;          /* current line while parsing */
+    int skip;          /* after a malformed section header: its keys are not read */
     const char *text;  /* string source */
     size_t pos;
     FILE *fp;
@@ -129,19 +131,58 @@ static entry_t *add(cfg_t *c, const char *section, const char *key, const char *
 
 /* ---- conversions ---------------------------------------------------- */
 
-static int parse_double(const char *s, double *v)
+/* A real number in decimal notation: [+-] digits [. digits] [e [+-] digits]
+ * (or .digits); no hexadecimal, inf or nan.  *end past it. */
+static int decimal_syntax(const char *s, const char **end)
 {
-    char *end;
-    errno = 0;
-    *v = strtod(s, &end);
-    if (end == s || errno == ERANGE) return 0;
-    while (isspace((unsigned char)*end)) end++;
-    return *end == 0 && isfinite(*v);
+    const char *p = s;
+    if (*p == '+' || *p == '-') p++;
+    const char *d0 = p;
+    while (isdigit((unsigned char)*p)) p++;
+    int digits = p > d0;
+    if (*p == '.') {
+        const char *f0 = ++p;
+        while (isdigit((unsigned char)*p)) p++;
+        digits |= p > f0;
+    }
+    if (!digits) return 0;
+    if (*p == 'e' || *p == 'E') {
+        const char *e = p + 1;
+        if (*e == '+' || *e == '-') e++;
+        if (!isdigit((unsigned char)*e)) return 0;
+        while (isdigit((unsigned char)*e)) e++;
+        p = e;
+    }
+    *end = p;
+    return 1;
 }
+
+/* One number at s (after blanks); 0 unless decimal and finite as a double. */
+static int real_at(const char *s, double *v, const char **end)
+{
+    while (isspace((unsigned char)*s)) s++;
+    if (!decimal_syntax(s, end)) return 0;
+    errno = 0;
+    *v = strtod(s, NULL);
+    if (errno == ERANGE && fabs(*v) > 1.0) return 0; /* overflow; an underflow is 0 or subnormal */
+    return isfinite(*v);
+}
+
+int cfg_parse_real(const char *s, double *v)
+{
+    const char *end;
+    if (!real_at(s, v, &end)) return 0;
+    while (isspace((unsigned char)*end)) end++;
+    return *end == 0;
+}
+
+static int parse_double(const char *s, double *v) { return cfg_parse_real(s, v); }
 
 static int parse_int(const char *s, int *v)
 {
     char *end;
+    while (isspace((unsigned char)*s)) s++;
+    if (!isdigit((unsigned char)s[*s == '+' || *s == '-'])) return 0;
     errno = 0;
     long l = strtol(s, &end, 10);
     if (end == s || errno == ERANGE || l > 2147483647L || l < -2147483647L) return 0;
@@ -160,17 +201,17 @@ static int parse_bool(const char *s, int *v)
     return 0;
 }
 
+/* Three numbers separated by blanks or commas. */
 static int parse_vec3(const char *s, double v[3])
 {
-    char buf[256];
-    snprintf(buf, sizeof buf, "%s", s);
-    for (char *p = buf; *p; p++)
-        if (*p == ',') *p = ' ';
-    char *p = buf, *end;
+    const char *p = s, *end;
     for (int i = 0; i < 3; i++) {
-        errno = 0;
-        v[i] = strtod(p, &end);
-        if (end == p || errno == ERANGE || !isfinite(v[i])) return 0;
+        if (i > 0) {
+            while (isspace((unsigned char)*p)) p++;
+            if (*p == ',') p++;
+        }
+        if (!real_at(p, &v[i], &end)) return 0;
+        if (*end && !isspace((unsigned char)*end) && *end != ',') return 0;
         p = end;
     }
     while (isspace((unsigned char)*p)) p++;
@@ -206,41 +247,72 @@ static const char *type_name(cfg_type_t t)
     return "?";
 }
 
-/* Check one value against its schema entry; returns 0 and fills `why` on error. */
-static int check_value(const cfg_key_t *k, const char *v, char *why, size_t nwhy)
+/* The value as quoted in a message: a long one is cut (at a character
+ * boundary) and ends with "...". */
+static const char *shown(const char *v, char *buf, size_t n)
 {
+    size_t len = strlen(v);
+    if (len < n) return v;
+    size_t cut = n - 4;
+    while (cut > 0 && ((unsigned char)v[cut] & 0xC0) == 0x80) cut--;
+    memcpy(buf, v, cut);
+    memcpy(buf + cut, "...", 4);
+    return buf;
+}
+
+/* Check one value against its schema entry; returns 0 and fills `why` on error. */
+/* A hint when strtod would read what the schema refuses (hexadecimal, inf,
+ * nan, or a number out of the range of a double). */
+static const char *number_hint(const char *v)
+{
+    char *end;
+    for (const char *p = v; *p; p++)
+        if (*p == ',') return ""; /* a VEC3: the hint is for single numbers */
+    strtod(v, &end);
+    while (isspace((unsigned char)*end)) end++;
+    return end != v && *end == 0 ? " (decimal notation only, finite, within ±1.8e308: no hexadecimal, inf or nan)"
+                                 : "";
+}
+
+static int check_value(const cfg_key_t *k, const char *value, char *why, size_t nwhy)
+{
+    char shortv[96];
+    const char *v = shown(value, shortv, sizeof shortv);
     double d, v3[3];
     int i;
     int ranged = k->min <= k->max;
     switch (k->type) {
     case CFG_DOUBLE:
-        if (!parse_double(v, &d)) { snprintf(why, nwhy, "'%s' is not %s", v, type_name(k->type)); return 0; }
+        if (!parse_double(value, &d)) {
+            snprintf(why, nwhy, "'%s' is not %s%s", v, type_name(k->type), number_hint(value));
+            return 0;
+        }
         if (ranged && (d < k->min || d > k->max)) {
             snprintf(why, nwhy, "%g is out of range [%g, %g]", d, k->min, k->max);
             return 0;
         }
         return 1;
     case CFG_INT:
-        if (!parse_int(v, &i)) { snprintf(why, nwhy, "'%s' is not %s", v, type_name(k->type)); return 0; }
+        if (!parse_int(value, &i)) { snprintf(why, nwhy, "'%s' is not %s", v, type_name(k->type)); return 0; }
         if (ranged && (i < k->min || i > k->max)) {
             snprintf(why, nwhy, "%d is out of range [%g, %g]", i, k->min, k->max);
             return 0;
         }
         return 1;
     case CFG_BOOL:
-        if (!parse_bool(v, &i)) { snprintf(why, nwhy, "'%s' is not %s", v, type_name(k->type)); return 0; }
+        if (!parse_bool(value, &i)) { snprintf(why, nwhy, "'%s' is not %s", v, type_name(k->type)); return 0; }
         return 1;
     case CFG_STRING:
-        if (!*v) { snprintf(why, nwhy, "empty value"); return 0; }
+        if (!*value) { snprintf(why, nwhy, "empty value"); return 0; }
         return 1;
     case CFG_ENUM:
-        if (enum_index(k->choices, v) < 0) {
+        if (enum_index(k->choices, value) < 0) {
             snprintf(why, nwhy, "'%s' is not one of %s", v, k->choices);
             return 0;
         }
         return 1;
     case CFG_VEC3:
-        if (!parse_vec3(v, v3)) { snprintf(why, nwhy, "'%s' is not %s", v, type_name(k->type)); return 0; }
+        if (!parse_vec3(value, v3)) { snprintf(why, nwhy, "'%s' is not %s", v, type_name(k->type)); return 0; }
         if (ranged)
             for (int j = 0; j < 3; j++)
                 if (v3[j] < k->min || v3[j] > k->max) {
@@ -254,79 +326,242 @@ static int check_value(const cfg_key_t *k, const char *v, char *why, size_t nwhy
 
 /* ---- parsing ---------------------------------------------------------- */
 
-static int handler(void *user, const char *section, const char *key, const char *value)
+static void handle(cfg_t *c, const char *section, const char *key, const char *value)
 {
-    cfg_t *c = user;
     char why[512];
     if (!schema_has_section(section)) {
         report(c, "%s:%d: [%s]: unknown section", c->path, c->line, section);
-        return 1;
+        return;
     }
     const cfg_key_t *k = cfg_schema_find(section, key);
     if (!k) {
         report(c, "%s:%d: %s.%s: unknown key", c->path, c->line, section, key);
-        return 1;
+        return;
     }
     entry_t *old = find(c, section, key);
     if (old && old->line > 0) {
         report(c, "%s:%d: %s.%s: given twice (first at line %d)", c->path, c->line, section, key, old->line);
-        return 1;
+        return;
     }
     if (!check_value(k, value, why, sizeof why)) {
         report(c, "%s:%d: %s.%s: %s", c->path, c->line, section, key, why);
-        return 1;
+        return;
     }
     add(c, section, key, value, "file", c->line);
-    return 1;
 }
 
-static char *reader_file(char *str, int num, void *stream)
+size_t cfg_utf8_char(const char *str, size_t n)
 {
-    cfg_t *c = stream;
-    char *r = fgets(str, num, c->fp);
-    if (r) c->line++;
-    return r;
-}
-
-static char *reader_string(char *str, int num, void *stream)
-{
-    cfg_t *c = stream;
-    if (!c->text[c->pos]) return NULL;
-    int n = 0;
-    while (n < num - 1 && c->text[c->pos]) {
-        char ch = c->text[c->pos++];
-        str[n++] = ch;
-        if (ch == '\n') break;
+    const unsigned char *s = (const unsigned char *)str;
+    if (n == 0) return 0;
+    if (s[0] < 0x80) return 1;
+    size_t len;
+    unsigned min;
+    unsigned cp;
+    if ((s[0] & 0xE0) == 0xC0) len = 2, min = 0x80, cp = s[0] & 0x1F;
+    else if ((s[0] & 0xF0) == 0xE0) len = 3, min = 0x800, cp = s[0] & 0x0F;
+    else if ((s[0] & 0xF8) == 0xF0) len = 4, min = 0x10000, cp = s[0] & 0x07;
+    else return 0;
+    if (n < len) return 0;
+    for (size_t i = 1; i < len; i++) {
+        if ((s[i] & 0xC0) != 0x80) return 0;
+        cp = (cp << 6) | (s[i] & 0x3F);
     }
-    str[n] = 0;
-    c->line++;
-    return str;
+    /* overlong forms, UTF-16 surrogates and code points past U+10FFFF are not UTF-8 */
+    if (cp < min || (cp >= 0xD800 && cp <= 0xDFFF) || cp > 0x10FFFF) return 0;
+    return len;
 }
 
-static cfg_t *finish(cfg_t *c, int rc, int nset, char **sets)
+/* Why the n bytes of s are not a line of text (NULL if they are): a NUL byte,
+ * a control character other than a tab, or bytes that are not UTF-8.  Column
+ * in *col (1-based, in bytes). */
+static const char *not_text(const char *s, size_t n, size_t *col, char *why, size_t nwhy)
 {
-    if (rc > 0) report(c, "%s:%d: syntax error (expected [section] or key = value)", c->path, rc);
+    for (size_t i = 0; i < n;) {
+        const unsigned char ch = (unsigned char)s[i];
+        *col = i + 1;
+        if (ch == 0) return "a NUL byte: this is not a text file";
+        if ((ch < 0x20 && ch != '\t') || ch == 0x7F) {
+            snprintf(why, nwhy, "control character 0x%02X", ch);
+            return why;
+        }
+        const size_t len = cfg_utf8_char(s + i, n - i);
+        if (!len) {
+            snprintf(why, nwhy, "byte 0x%02X is not UTF-8 text", ch);
+            return why;
+        }
+        i += len;
+    }
+    return NULL;
+}
+
+static char *trim(char *s)
+{
+    while (*s == ' ' || *s == '\t') s++;
+    char *e = s + strlen(s);
+    while (e > s && (e[-1] == ' ' || e[-1] == '\t')) *--e = 0;
+    return s;
+}
+
+/* One line of the case file (without its newline; a trailing CR is dropped):
+ * [section], key = value (or key: value), a comment (; or # first) or blank.
+ * A ';' after a blank starts a comment after a value.  `section` holds the
+ * current section (the caller's buffer, grown as needed). */
+static void parse_line(cfg_t *c, char *line, size_t len, char **section, size_t *seccap)
+{
+    if (len > 0 && line[len - 1] == '\r') line[--len] = 0;
+    if (c->line == 1 && len >= 3 && !memcmp(line, "\xEF\xBB\xBF", 3)) { /* a UTF-8 byte order mark */
+        line += 3;
+        len -= 3;
+    }
+    size_t col;
+    char whybuf[128];
+    const char *bad = not_text(line, len, &col, whybuf, sizeof whybuf);
+    if (bad) {
+        report(c, "%s:%d: column %zu: %s", c->path, c->line, col, bad);
+        return;
+    }
+    char *s = trim(line);
+    if (!*s || *s == ';' || *s == '#') return;
+    if (s != line) {
+        report(c, "%s:%d: an indented line: keys and [section] headers start at the beginning of the line "
+                  "(a value does not continue on the next line)",
+               c->path, c->line);
+        return;
+    }
+    if (*s == '[') {
+        c->skip = 1;
+        char *close = strchr(s, ']');
+        if (!close) {
+            report(c, "%s:%d: syntax error: '[' without ']' (a section header is [name])", c->path, c->line);
+            return;
+        }
+        *close = 0;
+        char *name = trim(s + 1), *rest = trim(close + 1);
+        if (*rest && *rest != ';' && *rest != '#') {
+            report(c, "%s:%d: syntax error: '%s' after the section header [%s]", c->path, c->line, rest, name);
+            return;
+        }
+        if (!*name) {
+            report(c, "%s:%d: syntax error: an empty section name []", c->path, c->line);
+            return;
+        }
+        const size_t ln = strlen(name) + 1;
+        if (ln > *seccap) {
+            *section = realloc(*section, ln);
+            *seccap = ln;
+        }
+        memcpy(*section, name, ln);
+        c->skip = 0;
+        return;
+    }
+    char *sep = s + strcspn(s, "=:");
+    if (!*sep) {
+        report(c, "%s:%d: syntax error (expected [section] or key = value)", c->path, c->line);
+        return;
+    }
+    const char sepc = *sep;
+    if (c->skip) return; /* the header above was reported */
+    *sep = 0;
+    char *key = trim(s), *value = sep + 1;
+    for (char *p = value; *p; p++)
+        if (*p == ';' && (p == value || p[-1] == ' ' || p[-1] == '\t')) {
+            *p = 0;
+            break;
+        }
+    value = trim(value);
+    if (!*key) {
+        report(c, "%s:%d: syntax error: no key before '%c'", c->path, c->line, sepc);
+        return;
+    }
+    if (!**section) {
+        report(c, "%s:%d: %s: a key before the first [section] header", c->path, c->line, key);
+        return;
+    }
+    handle(c, *section, key, value);
+}
+
+/* A case file is text of at most this many bytes (its data files are apart). */
+#define CFG_MAX_BYTES (16L << 20)
+
+/* Read the lines of the file (c->fp) or the string (c->text), each of any
+ * length, and parse them. */
+static void parse(cfg_t *c)
+{
+    size_t cap = 256, len = 0, seccap = 1;
+    char *line = malloc(cap), *section = calloc(1, 1);
+    long total = 0;
+    int eof = 0;
+    c->line = 0;
+    while (!eof) {
+        len = 0;
+        int ch;
+        for (;;) {
+            ch = c->fp ? getc(c->fp) : (c->text[c->pos] ? (unsigned char)c->text[c->pos++] : EOF);
+            if (ch == EOF || ch == '\n') break;
+            if (++total > CFG_MAX_BYTES) {
+                report(c, "%s:%d: the case file is longer than %ld bytes: not a case file", c->path, c->line + 1,
+                       CFG_MAX_BYTES);
+                goto done;
+            }
+            if (ch == 0) break; /* not text: reported by parse_line with the line number */
+            if (len + 2 > cap) line = realloc(line, cap *= 2);
+            line[len++] = (char)ch;
+        }
+        if (ch == EOF) {
+            eof = 1;
+            if (c->fp && ferror(c->fp)) {
+                report(c, "%s:%d: cannot read: %s", c->path, c->line + 1, strerror(errno));
+                break;
+            }
+            if (len == 0) break;
+        }
+        c->line++;
+        if (ch == 0) {
+            report(c, "%s:%d: column %zu: a NUL byte: this is not a text file", c->path, c->line, len + 1);
+            break;
+        }
+        line[len] = 0;
+        parse_line(c, line, len, &section, &seccap);
+    }
+done:
+    free(line);
+    free(section);
+}
+
+/* A --set value (or --out folder) is one line of UTF-8 text. */
+static int set_text_ok(cfg_t *c, const char *sec, const char *key, const char *v)
+{
+    size_t col;
+    char whybuf[128];
+    const char *bad = not_text(v, strlen(v), &col, whybuf, sizeof whybuf);
+    if (bad) report(c, "--set %s.%s: byte %zu of the value: %s", sec, key, col, bad);
+    return bad == NULL;
+}
+
+static cfg_t *finish(cfg_t *c, int nset, char **sets)
+{
     for (int s = 0; s < nset; s++) {
-        char buf[512], why[512];
-        snprintf(buf, sizeof buf, "%s", sets[s]);
+        char *buf = strdup(sets[s]), why[512];
         char *eq = strchr(buf, '='), *dot = strchr(buf, '.');
         if (!eq || !dot || dot > eq) {
             report(c, "--set %s: expected section.key=value", sets[s]);
+            free(buf);
             continue;
         }
         *eq = 0;
         *dot = 0;
         const char *sec = buf, *key = dot + 1, *val = eq + 1;
         const cfg_key_t *k = cfg_schema_find(sec, key);
-        if (!k) {
+        if (!k)
             report(c, "--set %s.%s: unknown key", sec, key);
-            continue;
-        }
-        if (!check_value(k, val, why, sizeof why)) {
+        else if (!set_text_ok(c, sec, key, val))
+            ;
+        else if (!check_value(k, val, why, sizeof why))
             report(c, "--set %s.%s: %s", sec, key, why);
-            continue;
-        }
-        add(c, sec, key, val, "--set", 0);
+        else
+            add(c, sec, key, val, "--set", 0);
+        free(buf);
     }
     if (c->nerr) {
         cfg_free(c);
@@ -340,15 +575,20 @@ cfg_t *cfg_load(const char *path, int nset, char **sets)
     cfg_t *c = calloc(1, sizeof *c);
     c->path = strdup(path);
     c->fp = fopen(path, "r");
-    if (!c->fp) {
-        report(c, "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    const char *why = !c->fp ? strerror(errno)
+                      : fstat(fileno(c->fp), &st) == 0 && S_ISDIR(st.st_mode) ? strerror(EISDIR)
+                                                                                : NULL;
+    if (why) {
+        report(c, "%s: cannot open: %s", path, why);
+        if (c->fp) fclose(c->fp);
         cfg_free(c);
         return NULL;
     }
-    int rc = ini_parse_stream(reader_file, c, handler, c);
+    parse(c);
     fclose(c->fp);
     c->fp = NULL;
-    return finish(c, rc, nset, sets);
+    return finish(c, nset, sets);
 }
 
 cfg_t *cfg_load_string(const char *name, const char *text, int nset, char **sets)
@@ -356,9 +596,9 @@ cfg_t *cfg_load_string(const char *name, const char *text, int nset, char **sets
     cfg_t *c = calloc(1, sizeof *c);
     c->path = strdup(name);
     c->text = text;
-    int rc = ini_parse_stream(reader_string, c, handler, c);
+    parse(c);
     c->text = NULL;
-    return finish(c, rc, nset, sets);
+    return finish(c, nset, sets);
 }
 
 void cfg_free(cfg_t *c)

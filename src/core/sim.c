@@ -6,9 +6,11 @@
 #include "sim.h"
 
 #include <inttypes.h>
+#include <limits.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "util.h"
 
@@ -26,7 +28,8 @@ static const cfg_key_t sim_keys[] = {
      "kinetic energy growing by more than this factor in one step means divergence"},
     {"time", "rollback", CFG_BOOL, "true", 1, 0, NULL,
      "keep the state at the start of each step, so a diverging run checkpoints its last good state "
-     "(costs one copy of the velocity and pressure)"},
+     "(costs one copy of the velocity and pressure, of the spheres, of the DEM's particles, springs and lists, "
+     "and of the pore network's state)"},
     {"output", "dir", CFG_STRING, "out/NAME", 1, 0, NULL, "output folder (created); --out DIR sets it too"},
     {"output", "name", CFG_STRING, "case file name", 1, 0, NULL, "case name written in summary.json"},
     {"output", "fields_every", CFG_DOUBLE, "0", 0, 1e300, NULL,
@@ -35,6 +38,9 @@ static const cfg_key_t sim_keys[] = {
     {"output", "checkpoint_every", CFG_INT, "0", 0, 2147483647, NULL,
      "steps between checkpoints (checkpoint_SSSSSSSS.h5); 0: at the end only"},
     {"output", "checkpoint_keep", CFG_INT, "2", 0, 1000000, NULL, "newest checkpoints kept in the folder; 0: all"},
+    {"output", "overwrite", CFG_BOOL, "false", 1, 0, NULL,
+     "a new run into a folder that holds the outputs of an earlier run: false: refused; true: those files are "
+     "deleted first (a restart continues in place whatever this is)"},
     {"output", "progress", CFG_ENUM, "auto", 1, 0, "auto|on|off",
      "progress line redrawn in place: auto = when stdout is a terminal and the run was not started by mpirun "
      "(whose processes always see a pseudo-terminal), on, off"},
@@ -58,6 +64,8 @@ static void read_params(sim_t *s, cfg_t *cfg)
     p->rollback = cfg_bool(cfg, "time", "rollback");
     /* The case name defaults to the file name without its directory and .ini */
     if (cfg_has(cfg, "output", "name")) {
+        if (strlen(cfg_string(cfg, "output", "name")) >= sizeof p->name)
+            cfg_fail(cfg, "output", "name", "longer than %zu bytes", sizeof p->name - 1);
         snprintf(p->name, sizeof p->name, "%s", cfg_string(cfg, "output", "name"));
     } else {
         const char *base = strrchr(cfg_path(cfg), '/');
@@ -65,10 +73,26 @@ static void read_params(sim_t *s, cfg_t *cfg)
         char *dot = strrchr(p->name, '.');
         if (dot && dot != p->name) *dot = 0;
     }
-    if (cfg_has(cfg, "output", "dir"))
+    if (cfg_has(cfg, "output", "dir")) {
+        if (strlen(cfg_string(cfg, "output", "dir")) >= sizeof p->dir)
+            cfg_fail(cfg, "output", "dir", "the path is longer than %zu bytes", sizeof p->dir - 1);
         snprintf(p->dir, sizeof p->dir, "%s", cfg_string(cfg, "output", "dir"));
-    else
+    } else {
         snprintf(p->dir, sizeof p->dir, "out/%s", p->name);
+    }
+    /* every file name inside the folder must fit in a path the system takes */
+    const size_t longest = strlen("/checkpoint_00000000000.h5.tmp") + 16;
+    if (strlen(p->dir) + longest >= PATH_MAX || strlen(p->dir) + longest >= IO_PATH_MAX)
+        cfg_fail(cfg, "output", "dir", "a path of %zu characters: at most %zu (the system's PATH_MAX %d less the "
+                 "longest file name inside it)", strlen(p->dir), (size_t)PATH_MAX - longest - 1, PATH_MAX);
+    for (const char *c = p->dir; *c;) {
+        size_t len = strcspn(c, "/");
+        if (len > NAME_MAX)
+            cfg_fail(cfg, "output", "dir", "a folder name of %zu characters: at most %d (the system's NAME_MAX)", len,
+                     NAME_MAX);
+        c += len + (c[len] == '/');
+    }
+    p->overwrite = cfg_bool(cfg, "output", "overwrite");
     p->fields_every = cfg_double(cfg, "output", "fields_every");
     p->series_every = cfg_int(cfg, "output", "series_every");
     p->checkpoint_every = cfg_int(cfg, "output", "checkpoint_every");
@@ -84,6 +108,12 @@ void sim_add_part(sim_t *s, const sim_part_t *part)
     s->part[s->npart++] = *part;
 }
 
+void sim_add_output_name(sim_t *s, const char *name)
+{
+    if (s->noutput_names == SIM_MAX_PARTS) die("too many output names (SIM_MAX_PARTS = %d)", SIM_MAX_PARTS);
+    s->output_names[s->noutput_names++] = name;
+}
+
 void sim_add_field_writer(sim_t *s, sim_field_writer_t fn, void *ctx)
 {
     if (s->nfield_writers == SIM_MAX_PARTS) die("too many snapshot field writers (SIM_MAX_PARTS = %d)", SIM_MAX_PARTS);
@@ -93,11 +123,40 @@ void sim_add_field_writer(sim_t *s, sim_field_writer_t fn, void *ctx)
 
 /* ---- checkpoints --------------------------------------------------------- */
 
-static void write_checkpoint(sim_t *s)
+/* The step of the last series row at or before `step` (the row a checkpoint
+ * of that step follows: a diverged run checkpoints the step before its last
+ * row). */
+static long series_row_before(const sim_t *s, long step)
 {
+    return s->last_series_step <= step ? s->last_series_step : s->prev_series_step;
+}
+
+/* What to say if the run must stop at once (a failed collective write). */
+static void note_checkpoint(const sim_t *s, const char *path)
+{
+    char text[IO_PATH_MAX + 64];
+    snprintf(text, sizeof text, "the newest checkpoint is %s", path);
+    io_recovery_note(text);
+}
+
+/* Write a checkpoint of the current state.  The time series and the log are
+ * made durable (fsync) first, and the checkpoint is renamed to its final name
+ * only when complete: whenever a checkpoint exists, the outputs it refers to
+ * do too.  Returns 0, or -1 on every rank after an I/O error (the previous
+ * checkpoint is then still the newest). */
+static int write_checkpoint(sim_t *s)
+{
+    if (mpi_rank() == 0) {
+        io_series_sync_all();
+        msg_sync_log();
+    }
     io_checkpoint_header_t h = {s->time, s->step, s->fingerprint, mpi_size(), s->input};
     hid_t f = io_checkpoint_begin(s->out.dir, &h, s->comm);
     io_h5_attr_double(f, "next_fields_time", s->next_fields);
+    io_h5_attr_long(f, "series_last_step", series_row_before(s, s->step));
+    io_h5_attr_hash(f, "series_hash", io_series_hash(s->series, s->step), s->comm);
+    io_h5_attr_long(f, "fields_last_step", s->last_fields_step);
+    io_h5_attr_double(f, "last_dt", s->dt);
     for (int i = 0; i < s->npart; i++) {
         sim_part_t *p = &s->part[i];
         if (!p->checkpoint_write) continue;
@@ -105,9 +164,21 @@ static void write_checkpoint(sim_t *s)
         p->checkpoint_write(p->ctx, g);
         H5Gclose(g);
     }
-    io_checkpoint_end(f, s->out.dir, s->step, s->prm.checkpoint_keep, s->last_checkpoint, sizeof s->last_checkpoint,
-                      s->comm);
+    if (io_checkpoint_end(f, s->out.dir, s->step, s->prm.checkpoint_keep, s->last_checkpoint,
+                          sizeof s->last_checkpoint, s->comm))
+        return -1;
     s->last_checkpoint_step = s->step;
+    note_checkpoint(s, s->last_checkpoint);
+    return 0;
+}
+
+/* Rank 0 decides: do two paths name the same file? */
+static int same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    int same = stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
+    MPI_Bcast(&same, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    return same;
 }
 
 static void report_diff(const char *key, const char *va, const char *vb, void *ctx)
@@ -132,6 +203,24 @@ static void read_checkpoint(sim_t *s, const char *path)
     s->time = h.time;
     s->step = h.step;
     if (io_h5_get_attr_double(f, "next_fields_time", &s->next_fields)) s->next_fields = s->time;
+    s->series_resume.step = s->step;
+    if (io_h5_get_attr_long(f, "series_last_step", &s->series_resume.last_row)) s->series_resume.last_row = -1;
+    s->series_resume.has_hash = io_h5_get_attr_hash(f, "series_hash", &s->series_resume.hash) == 0;
+    if (io_h5_get_attr_long(f, "fields_last_step", &s->last_fields_step)) s->last_fields_step = -1;
+    if (io_h5_get_attr_double(f, "last_dt", &s->dt)) s->dt = 0;
+    /* the folder's own checkpoint of this step: not written again at the end */
+    char own[IO_PATH_MAX + 64];
+    snprintf(own, sizeof own, "%s/checkpoint_%08ld.h5", s->out.dir, s->step);
+    if (same_file(own, path)) {
+        snprintf(s->last_checkpoint, sizeof s->last_checkpoint, "%s", own);
+        s->last_checkpoint_step = s->step;
+    }
+    /* what the lost continuation of this checkpoint wrote in the folder: its
+     * checkpoints (else they would be kept as the newest and ours pruned; the
+     * unfinished ones went when the folder was opened); the parts delete
+     * their own snapshots after theirs */
+    io_outdir_remove_numbered(&s->out, "checkpoint_", ".h5", s->step + 1);
+    io_checkpoint_prune(s->out.dir, s->prm.checkpoint_keep); /* a run killed before it pruned */
     for (int i = 0; i < s->npart; i++) {
         sim_part_t *p = &s->part[i];
         if (!p->checkpoint_read) continue;
@@ -143,6 +232,7 @@ static void read_checkpoint(sim_t *s, const char *path)
     }
     io_checkpoint_header_free(&h);
     io_h5_close(f);
+    note_checkpoint(s, path);
     msg("restarted from %s at step %ld, t = %.10g\n", path, s->step, s->time);
 }
 
@@ -153,11 +243,12 @@ static void write_fftw_wisdom(const sim_t *s)
 {
     const char *w = poisson_fftw_wisdom_used();
     if (!w || mpi_rank() != 0) return;
-    char path[IO_PATH_MAX + 16];
+    char path[IO_PATH_MAX + 16], tmp[IO_PATH_MAX + 32];
     io_outdir_path(&s->out, "fftw.wisdom", path, sizeof path);
-    FILE *f = fopen(path, "wb");
-    size_t n = strlen(w);
-    if (!f || fwrite(w, 1, n, f) != n || fclose(f) != 0) die_local("cannot write %s", path);
+    FILE *f = atomic_open(path, tmp, sizeof tmp);
+    if (!f) return;
+    fputs(w, f);
+    atomic_commit(f, tmp, path);
 }
 
 /* ---- setup ----------------------------------------------------------------- */
@@ -180,10 +271,15 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
     s->input = io_resolved_input(cfg);
     s->fingerprint = io_input_fingerprint(s->input, sim_run_control_keys);
     s->next_fields = 0.0;
-    s->last_fields_step = s->last_series_step = s->last_checkpoint_step = -1;
+    s->last_fields_step = s->last_series_step = s->prev_series_step = s->last_checkpoint_step = -1;
     if (check_only) return s;
 
-    io_outdir_open(&s->out, s->prm.dir, restart != NULL, s->comm);
+    char why[IO_PATH_MAX + 1024];
+    s->output_names[s->noutput_names] = NULL;
+    const int rc = io_outdir_open(&s->out, s->prm.dir, restart != NULL, s->prm.overwrite, s->output_names, why,
+                                  sizeof why, s->comm);
+    if (rc == 2) cfg_fail(cfg, "output", "dir", "%s: %s", s->prm.dir, why);
+    if (rc) die("output folder %s: %s", s->prm.dir, why);
     io_outdir_write_input(&s->out, cfg);
     msg("ibmdem %s: case %s (%s) on %d rank%s, output in %s\n", IBMDEM_VERSION, s->prm.name, cfg_path(cfg),
         mpi_size(), mpi_size() > 1 ? "s" : "", s->prm.dir);
@@ -202,7 +298,10 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
     names[nc++] = "wall_per_step";
     char path[IO_PATH_MAX + 16];
     io_outdir_path(&s->out, "series.csv", path, sizeof path);
-    s->series = io_series_open(path, nc, names, restart ? s->step : -1);
+    s->series = io_series_open(path, nc, names, restart ? &s->series_resume : NULL);
+    long last_row = io_series_last_step(s->series); /* rank 0's file */
+    MPI_Bcast(&last_row, 1, MPI_LONG, 0, s->comm);
+    s->last_series_step = s->prev_series_step = last_row;
     s->summary = io_summary_create();
     return s;
 }
@@ -213,7 +312,11 @@ static double stable_dt(sim_t *s)
 {
     double dt = INFINITY;
     for (int i = 0; i < s->npart; i++)
-        if (s->part[i].stable_dt) dt = fmin(dt, s->part[i].stable_dt(s->part[i].ctx));
+        if (s->part[i].stable_dt) {
+            const double l = s->part[i].stable_dt(s->part[i].ctx);
+            if (!(l > 0)) return l; /* zero, negative or not a number: no step (sim_run stops) */
+            dt = fmin(dt, l);
+        }
     for (int i = 0; i < s->npart; i++)
         if (s->part[i].align_dt) dt = fmin(dt, s->part[i].align_dt(s->part[i].ctx, dt));
     /* Land on t_end: a last step shortened (or slightly stretched, by less
@@ -235,6 +338,7 @@ static void advance(sim_t *s, double dt)
     s->wall_step = wtime() - w0;
     s->time += dt;
     s->step++;
+    s->dt_prev = s->dt;
     s->dt = dt;
 }
 
@@ -256,6 +360,10 @@ static int diagnostics(sim_t *s, double *row)
 /* Any part diverged?  The first reason found is kept in s->why. */
 static int diverged(sim_t *s)
 {
+    if (fault_armed("diverge", s->step)) { /* a test: a divergence at a chosen step */
+        snprintf(s->why, sizeof s->why, "%s: divergence injected by IBMDEM_FAULT", s->part[s->npart - 1].name);
+        return 1;
+    }
     for (int i = 0; i < s->npart; i++) {
         char why[400];
         if (s->part[i].diverged && s->part[i].diverged(s->part[i].ctx, why, sizeof why)) {
@@ -279,6 +387,13 @@ static double progress_fraction(const sim_t *s)
  * wall clock, which rank 0 decides. */
 static sim_status_t stop_condition(sim_t *s)
 {
+    for (int i = 0; i < s->npart; i++) {
+        char why[400];
+        if (s->part[i].halt && s->part[i].halt(s->part[i].ctx, why, sizeof why)) {
+            snprintf(s->why, sizeof s->why, "%s: %s", s->part[i].name, why);
+            return SIM_HALTED;
+        }
+    }
     if (s->time >= s->prm.t_end) return SIM_T_END;
     for (int i = 0; i < s->npart; i++)
         if (s->part[i].done && s->part[i].done(s->part[i].ctx)) return SIM_DONE;
@@ -316,17 +431,19 @@ static void write_series_row(sim_t *s)
     double row[SIM_MAX_COLS + 8];
     diagnostics(s, row);
     io_series_row(s->series, row);
+    s->prev_series_step = s->last_series_step;
     s->last_series_step = s->step;
 }
 
-/* The outputs due after this step. */
-static void outputs(sim_t *s)
+/* The outputs due after this step.  Returns -1 (every rank) after an I/O
+ * error: a write failed somewhere (io_check_errors). */
+static int outputs(sim_t *s)
 {
     if (s->step % s->prm.series_every == 0) write_series_row(s);
     if (s->time >= s->next_fields * (1.0 - 1e-12)) write_fields(s);
     if (s->prm.checkpoint_every > 0 && s->step % s->prm.checkpoint_every == 0) {
         io_progress_clear(&s->progress);
-        write_checkpoint(s);
+        if (write_checkpoint(s)) return -1;
     }
     /* a line in the log every 10 % of the run (the terminal has the progress line) */
     double frac = progress_fraction(s);
@@ -338,17 +455,20 @@ static void outputs(sim_t *s)
         while (s->next_report <= frac) s->next_report += 0.1;
     }
     io_progress_update(&s->progress, s->time, s->step, frac);
+    return io_check_errors(s->comm, s->io_why, sizeof s->io_why) ? -1 : 0;
 }
 
 static void write_summary(sim_t *s)
 {
-    static const char *status_name[] = {"running", "t_end", "max_steps", "wall_limit", "steady", "diverged", "done"};
+    static const char *status_name[] = {"running", "t_end",    "max_steps", "wall_limit",
+                                        "steady",  "diverged", "done",      "halted", "io_error"};
     io_summary_t *y = s->summary;
     double wall = wtime() - s->wall0;
     io_summary_string(y, "case", s->prm.name);
     io_summary_string(y, "input", cfg_path(s->cfg));
     io_summary_string(y, "status", status_name[s->status]);
-    if (s->status == SIM_DIVERGED) io_summary_string(y, "reason", s->why);
+    if (s->status == SIM_DIVERGED || s->status == SIM_HALTED) io_summary_string(y, "reason", s->why);
+    if (s->status == SIM_IO_ERROR) io_summary_string(y, "reason", s->io_why);
     io_summary_string(y, "ibmdem_version", IBMDEM_VERSION);
     io_summary_long(y, "ranks", mpi_size());
     io_summary_long(y, "steps", s->step);
@@ -364,7 +484,48 @@ static void write_summary(sim_t *s)
         if (s->part[i].summary) s->part[i].summary(s->part[i].ctx, y, s->part[i].name);
     char path[IO_PATH_MAX + 16];
     io_outdir_path(&s->out, "summary.json", path, sizeof path);
-    if (io_summary_write(y, path)) warn("cannot write %s\n", path);
+    io_summary_write(y, path);
+}
+
+/* Rank 0: an error message on stderr and in the log. */
+static void report_error(const sim_t *s, const char *text)
+{
+    if (mpi_rank() != 0) return;
+    fprintf(stderr, "error: %s", text);
+    if (s->out.log) {
+        fprintf(s->out.log, "error: %s", text);
+        msg_sync_log();
+    }
+}
+
+/* A write failed (s->io_why): checkpoint the state if it can be, and say how
+ * to go on.  Returns the exit status 1. */
+static int stop_io_error(sim_t *s)
+{
+    io_progress_clear(&s->progress);
+    s->status = SIM_IO_ERROR;
+    int saved = s->last_checkpoint_step == s->step;
+    if (!saved) {
+        /* the error is known: see whether a checkpoint can still be written (another file system, room freed) */
+        io_error_clear();
+        saved = write_checkpoint(s) == 0;
+    }
+    io_error_clear();
+    write_summary(s);
+    char text[6 * IO_PATH_MAX], cmd[3 * IO_PATH_MAX];
+    int len = snprintf(text, sizeof text, "%s\n", s->io_why);
+    if (s->last_checkpoint[0] || s->restart_path[0]) {
+        const char *ckpt = s->last_checkpoint[0] ? s->last_checkpoint : s->restart_path;
+        sim_restart_command(s, ckpt, cmd, sizeof cmd);
+        snprintf(text + len, sizeof text - len,
+                 "  %s %s\n  once the disk has room, continue with:\n    %s\n",
+                 saved ? "the state at this step is saved in" : "no checkpoint could be written; the newest is", ckpt,
+                 cmd);
+    } else {
+        snprintf(text + len, sizeof text - len, "  no checkpoint could be written\n");
+    }
+    report_error(s, text);
+    return 1;
 }
 
 /* The run diverged: bring back the state at the start of the failed step,
@@ -372,30 +533,74 @@ static void write_summary(sim_t *s)
 static int stop_diverged(sim_t *s)
 {
     long bad_step = s->step;
-    double bad_time = s->time;
+    double bad_time = s->time, bad_dt = s->dt;
     io_progress_clear(&s->progress);
     write_series_row(s); /* the failed step, as it came out */
+    /* every part with a state must be able to bring it back */
     int restored = s->prm.rollback;
-    for (int i = 0; i < s->npart && restored; i++) restored = s->part[i].restore_previous != NULL;
+    for (int i = 0; i < s->npart && restored; i++)
+        restored = s->part[i].restore_previous != NULL || s->part[i].checkpoint_write == NULL;
     if (restored) {
-        for (int i = 0; i < s->npart; i++) s->part[i].restore_previous(s->part[i].ctx);
+        for (int i = 0; i < s->npart; i++)
+            if (s->part[i].restore_previous) s->part[i].restore_previous(s->part[i].ctx);
         s->time = s->time_prev;
         s->step = s->step_prev;
+        s->dt = s->dt_prev;
     }
-    write_checkpoint(s);
+    if (write_checkpoint(s) != 0) {
+        io_check_errors(s->comm, s->io_why, sizeof s->io_why);
+        char text[2 * IO_PATH_MAX];
+        snprintf(text, sizeof text, "the run diverged at step %ld (t = %.10g): %s\n", bad_step, bad_time, s->why);
+        report_error(s, text);
+        return stop_io_error(s);
+    }
     s->status = SIM_DIVERGED;
     write_summary(s);
-    char text[4 * IO_PATH_MAX];
+    char text[6 * IO_PATH_MAX], cmd[3 * IO_PATH_MAX], hint[128];
+    sim_restart_command(s, s->last_checkpoint, cmd, sizeof cmd);
+    sim_smaller_step_hint(s, hint, sizeof hint);
     snprintf(text, sizeof text,
              "the run diverged at step %ld (t = %.10g, dt = %.6g): %s\n"
              "  the state %s (step %ld, t = %.10g) is saved in %s\n"
-             "  continue from it with a smaller time step: ibmdem run %s --restart %s --set ...\n",
-             bad_step, bad_time, s->dt, s->why, restored ? "at the start of that step" : "after that step", s->step,
-             s->time, s->last_checkpoint, cfg_path(s->cfg), s->last_checkpoint);
-    if (mpi_rank() == 0) {
-        fprintf(stderr, "error: %s", text);
-        if (s->out.log) fprintf(s->out.log, "error: %s", text);
+             "  continue from it with a smaller time step, e.g.:\n    %s %s\n",
+             bad_step, bad_time, bad_dt, s->why, restored ? "at the start of that step" : "after that step", s->step,
+             s->time, s->last_checkpoint, cmd, hint);
+    report_error(s, text);
+    return 3;
+}
+
+/* No step can be taken: the time step the parts allow is zero, not a number,
+ * or too small to change the time.  The run stops as diverged, with a
+ * checkpoint of the state it is in (nothing was advanced). */
+static int stop_no_step(sim_t *s, double dt)
+{
+    const char *who = "the run driver";
+    double least = INFINITY;
+    for (int i = 0; i < s->npart; i++) {
+        const double l = s->part[i].stable_dt ? s->part[i].stable_dt(s->part[i].ctx) : INFINITY;
+        if (!(l >= least)) { /* the smallest limit, or the first that is not a number */
+            least = l;
+            who = s->part[i].name;
+            if (isnan(l)) break;
+        }
     }
+    snprintf(s->why, sizeof s->why, "the time step is %g (limit of %s): the state cannot advance from t = %.10g", dt,
+             who, s->time);
+    io_progress_clear(&s->progress);
+    if (s->last_series_step != s->step) write_series_row(s);
+    char text[2 * IO_PATH_MAX];
+    snprintf(text, sizeof text, "the run cannot go on at step %ld: %s\n", s->step, s->why);
+    if (s->last_checkpoint_step != s->step && write_checkpoint(s) != 0) {
+        io_check_errors(s->comm, s->io_why, sizeof s->io_why);
+        report_error(s, text);
+        return stop_io_error(s);
+    }
+    s->status = SIM_DIVERGED;
+    write_summary(s);
+    const size_t len = strlen(text);
+    snprintf(text + len, sizeof text - len, "  the state (step %ld, t = %.10g) is saved in %s\n", s->step, s->time,
+             s->last_checkpoint);
+    report_error(s, text);
     return 3;
 }
 
@@ -417,14 +622,15 @@ int sim_run(sim_t *s)
         /* 1. the time step: the most restrictive limit of every part
          *    (fluid: fluid_stable_dt, convective CFL and explicit viscous limit) */
         double dt = stable_dt(s);
+        if (!(dt > 0) || !isfinite(dt) || s->time + dt == s->time) return stop_no_step(s, dt);
         /* 2. advance every part by dt (fluid: fluid_step, three RK3 stages,
          *    each projected to a divergence-free velocity) */
         advance(s, dt);
         if (s->step == s->step0 + 1) sim_note_unused(s); /* every part has read its keys */
         /* 3. diagnostics and checks; a diverged run stops with a checkpoint */
         if (diverged(s)) return stop_diverged(s);
-        /* 4. the outputs due at this step */
-        outputs(s);
+        /* 4. the outputs due at this step; a failed write stops the run */
+        if (outputs(s)) return stop_io_error(s);
     }
     /* The end: last series row, snapshot and checkpoint, then the summary. */
     io_progress_clear(&s->progress);
@@ -433,14 +639,37 @@ int sim_run(sim_t *s)
     /* a scene whose parts have no state (a fixed packing solved once) has nothing to restart from */
     int state = 0;
     for (int i = 0; i < s->npart; i++) state |= s->part[i].checkpoint_write != NULL;
-    if (s->last_checkpoint_step != s->step && state) write_checkpoint(s);
+    if (s->last_checkpoint_step != s->step && state && write_checkpoint(s) != 0) {
+        io_check_errors(s->comm, s->io_why, sizeof s->io_why);
+        return stop_io_error(s);
+    }
     write_summary(s);
+    if (s->status == SIM_HALTED) {
+        if (mpi_rank() == 0) io_series_sync_all();
+        char text[2 * IO_PATH_MAX];
+        snprintf(text, sizeof text, "the run stopped at step %ld (t = %.10g): %s\n  its state is saved in %s\n",
+                 s->step, s->time, s->why, s->last_checkpoint);
+        report_error(s, text);
+        if (io_check_errors(s->comm, s->io_why, sizeof s->io_why)) return stop_io_error(s);
+        return 1;
+    }
     static const char *why[] = {"", "reached t_end", "reached max_steps", "reached the wall-time limit",
                                 "reached a steady state", "", "has what it was run for (a part is done)"};
     double wall = wtime() - s->wall0;
     msg("%s: %s at step %ld, t = %.10g (%ld steps in %.3g s, %.4g steps/s); checkpoint %s\n", s->prm.name,
         why[s->status], s->step, s->time, s->step - s->step0, wall, wall > 0 ? (s->step - s->step0) / wall : 0.0,
         s->last_checkpoint[0] ? s->last_checkpoint : "none (no part has a state to restart from)");
+    /* everything written is on the disk, or the run says it is not */
+    if (mpi_rank() == 0) {
+        io_series_sync_all();
+        msg_sync_log();
+    }
+    if (io_check_errors(s->comm, s->io_why, sizeof s->io_why)) {
+        char text[3 * IO_PATH_MAX];
+        snprintf(text, sizeof text, "%s\n  the state at the end is saved in %s\n", s->io_why, s->last_checkpoint);
+        report_error(s, text);
+        return 1;
+    }
     return 0;
 }
 
@@ -455,5 +684,6 @@ void sim_free(sim_t *s)
     io_summary_free(s->summary);
     if (!s->check_only) io_outdir_close(&s->out);
     free(s->input);
+    free(s->command);
     free(s);
 }

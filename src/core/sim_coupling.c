@@ -48,6 +48,11 @@ static const cfg_key_t coupling_keys[] = {
     {"coupling", "added_mass_coefficient", CFG_DOUBLE, "0.5", 0, 10, NULL,
      "added_mass = consistent: C_M (1/2, a sphere in unbounded fluid, the seed's value for walls and pairs; "
      "0.803, a sphere touching a wall or the symmetry plane of two equal spheres, docs/theory.md §9.1)"},
+    {"coupling", "implicit_drag", CFG_DOUBLE, "0", 0, 1e6, NULL,
+     "K > 0: inside the DEM sub-steps the held hydrodynamic force and torque respond to the particle's velocity "
+     "change since the fluid step, -K 3 pi eta D (U - U_n) and -K pi eta D^3 (omega - omega_n), so that a particle "
+     "whose relaxation time is shorter than the fluid step is not driven by a stale force (docs/theory.md §9.1); "
+     "0: the held force alone (the seed's)"},
     {"coupling", "restitution_axis", CFG_VEC3, NULL, -1e300, 1e300, NULL,
      "wall: direction from the particle towards the wall (default: along gravity)"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
@@ -73,8 +78,15 @@ typedef struct {
     coupling_numbers_t num; /* of particle 0 (a bounce) or of the mean particle; num.D = 0: none */
     coupling_freeze_t fz;
     coupling_added_mass_t am; /* [coupling] added_mass = consistent (am.n > 0) */
+    coupling_drag_t drag;     /* [coupling] implicit_drag > 0 (drag.n > 0) */
     double wall_dem;     /* wall time in the DEM */
     long substeps;       /* DEM sub-steps done */
+    /* the state at the start of the step (rollback) */
+    restitution_t prev_rest;   /* its trajectory samples are in prev_traj */
+    double *prev_fz, *prev_dU; /* F0, J, held (13n); dU (3n) */
+    double *prev_traj;         /* the tracker's trajectory samples (2 prev_rest.ntraj) */
+    long prev_captraj;
+    long prev_substeps;
 } coupling_part_t;
 
 static const char *const rest_cols[] = {"approach_speed", "lubrication_force"};
@@ -190,6 +202,36 @@ static double part_align_dt(void *ctx, double T)
     return aim > T ? 0.5 * aim : aim;
 }
 
+/* The step limit of the particles' acceleration from rest (the immersed
+ * boundary limits the step by their velocities, ibm_stable_dt): a particle
+ * at rest, whose held force vanished, accelerates at most by its immersed
+ * weight, a = |g| (m_p − ρV_p)/m (m with any added mass), and moves a cell
+ * in √(2h/a): the step is at most the CFL target over √(a/h), as the
+ * immersed boundary does for a free sphere.  (With implicit_drag a single
+ * particle's speed within the step stays below a m/c, c = K 3πηD, but the
+ * fluid a settling crowd sets in motion does not: that bound let a scene of
+ * 150 grains at rest take a first step that put the fluid at CFL 2.) */
+static double part_stable_dt(void *ctx)
+{
+    coupling_part_t *cp = ctx;
+    setup(cp);
+    if (!cp->ibm || cp->sim->fluid->prm.dt_fixed > 0) return INFINITY;
+    const grid_t *g = cp->ibm->g;
+    const double h = grid_min_spacing(g);
+    const double gg = sqrt(cp->gravity[0] * cp->gravity[0] + cp->gravity[1] * cp->gravity[1] +
+                           cp->gravity[2] * cp->gravity[2]);
+    const double *r = dem_radii(cp->d);
+    const unsigned char *fx = dem_fixed(cp->d);
+    double rate = 0.0;
+    for (int i = 0; i < dem_count(cp->d); i++) {
+        if (fx[i]) continue;
+        const double V = 4.0 / 3.0 * M_PI * r[i] * r[i] * r[i], m = dem_mass(cp->d, i);
+        const double a = gg * fabs(dem_density(cp->d, i) - cp->rho_f) * V / m;
+        rate = fmax(rate, sqrt(a / h));
+    }
+    return rate > 0 ? cp->sim->fluid->prm.cfl / rate : INFINITY;
+}
+
 static void part_advance(void *ctx, double dt)
 {
     coupling_part_t *cp = ctx;
@@ -198,7 +240,8 @@ static void part_advance(void *ctx, double dt)
         const double w0 = wtime();
         coupling_added_mass_t *am = cp->am.n ? &cp->am : NULL;
         coupling_forces_to_dem(cp->ibm, cp->d, cp->rho_f, cp->gravity, cp->fz.n ? &cp->fz : NULL, am, dt);
-        cp->status = dem_advance(cp->d, dem_time(cp->d) + dt);
+        cp->status = cp->drag.n ? coupling_drag_advance(&cp->drag, cp->ibm, cp->d, am, dt)
+                                : dem_advance(cp->d, dem_time(cp->d) + dt);
         if (am) coupling_added_mass_after_step(am, cp->d);
         cp->wall_dem += wtime() - w0;
         if (cp->status == DEM_OK) coupling_motion_to_ibm(cp->d, cp->ibm);
@@ -225,6 +268,60 @@ static int part_diverged(void *ctx, char *why, size_t n)
     return 1;
 }
 
+/* The state at the start of the step, and back (the DEM and the spheres
+ * are brought back by their own parts). */
+static void part_keep_previous(void *ctx)
+{
+    coupling_part_t *cp = ctx;
+    const size_t n = (size_t)cp->fz.n, na = (size_t)cp->am.n;
+    cp->prev_rest = cp->rest;
+    const long nt = cp->rest.ntraj;
+    if (nt > cp->prev_captraj) {
+        cp->prev_captraj = cp->rest.captraj;
+        free(cp->prev_traj);
+        cp->prev_traj = xcalloc(2 * (size_t)cp->prev_captraj, sizeof(double));
+    }
+    if (nt) memcpy(cp->prev_traj, cp->rest.traj, 2 * (size_t)nt * sizeof(double));
+    cp->prev_substeps = cp->substeps;
+    if (n) {
+        if (!cp->prev_fz) cp->prev_fz = xcalloc(13 * n, sizeof(double));
+        memcpy(cp->prev_fz, cp->fz.F0, 6 * n * sizeof(double));
+        memcpy(cp->prev_fz + 6 * n, cp->fz.J, 6 * n * sizeof(double));
+        memcpy(cp->prev_fz + 12 * n, cp->fz.held, n * sizeof(double));
+    }
+    if (na) {
+        if (!cp->prev_dU) cp->prev_dU = xcalloc(3 * na, sizeof(double));
+        memcpy(cp->prev_dU, cp->am.dU, 3 * na * sizeof(double));
+    }
+}
+
+static void part_restore_previous(void *ctx)
+{
+    coupling_part_t *cp = ctx;
+    const size_t n = (size_t)cp->fz.n, na = (size_t)cp->am.n;
+    /* the samples go back into the tracker's own array (the step may have grown or cleared it) */
+    double *traj = cp->rest.traj;
+    long cap = cp->rest.captraj;
+    const long nt = cp->prev_rest.ntraj;
+    if (nt > cap) {
+        free(traj);
+        cap = cp->prev_captraj;
+        traj = xcalloc(2 * (size_t)cap, sizeof(double));
+    }
+    cp->rest = cp->prev_rest;
+    cp->rest.traj = traj;
+    cp->rest.captraj = cap;
+    if (nt) memcpy(traj, cp->prev_traj, 2 * (size_t)nt * sizeof(double));
+    cp->substeps = cp->prev_substeps;
+    cp->status = DEM_OK;
+    if (n && cp->prev_fz) {
+        memcpy(cp->fz.F0, cp->prev_fz, 6 * n * sizeof(double));
+        memcpy(cp->fz.J, cp->prev_fz + 6 * n, 6 * n * sizeof(double));
+        memcpy(cp->fz.held, cp->prev_fz + 12 * n, n * sizeof(double));
+    }
+    if (na && cp->prev_dU) memcpy(cp->am.dU, cp->prev_dU, 3 * na * sizeof(double));
+}
+
 /* The tracker's state (exact restarts of the measurements). */
 #define REST_NSCALAR 16
 #define REST_NSTATE (REST_NSCALAR + 13)
@@ -249,6 +346,7 @@ static void part_checkpoint_write(void *ctx, hid_t grp)
     pack(&cp->rest, v);
     io_h5_write_array(grp, "restitution", REST_NSTATE, v);
     if (cp->rest.ntraj > 0) io_h5_write_array(grp, "restitution_trajectory", 2 * cp->rest.ntraj, cp->rest.traj);
+    io_h5_attr_long(grp, "dem_substeps", cp->substeps);
     if (cp->fz.n) {
         io_h5_write_array(grp, "freeze_force", 6L * cp->fz.n, cp->fz.F0);
         io_h5_write_array(grp, "freeze_impulse", 6L * cp->fz.n, cp->fz.J);
@@ -283,6 +381,7 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
             die("%s: /coupling/restitution_trajectory is missing or has the wrong size", path);
         r->ntraj = nt;
     }
+    if (io_h5_get_attr_long(grp, "dem_substeps", &cp->substeps)) cp->substeps = 0;
     if (cp->fz.n) {
         const long n = cp->fz.n;
         if (io_h5_read_array(grp, "freeze_force", 6 * n, cp->fz.F0) != 6 * n ||
@@ -379,12 +478,53 @@ static int part_done(void *ctx)
     }
 }
 
+/* A mobile particle crossing a face of the fluid's domain that has no DEM
+ * wall: the fluid alone would let it sink through (no contact law there).
+ * Returns its id + 1 (0: none) and the face. */
+static long unwalled_touch(const dem_t *d, const grid_t *g, const char **face_name)
+{
+    static const char *face[3][2] = {{"x_lo", "x_hi"}, {"y_lo", "y_hi"}, {"z_lo", "z_hi"}};
+    const double *x = dem_positions(d), *r = dem_radii(d);
+    const unsigned char *fixed = dem_fixed(d);
+    for (int a = 0; a < g->dim; a++)
+        for (int side = 0; side < 2; side++) {
+            if (g->bc.type[a][side] == BC_PERIODIC || g->bc.type[a][side] == BC_AXIS) continue;
+            const int w = dem_wall_find(d, face[a][side]);
+            if (w >= 0 && dem_wall_active(d, w)) continue;
+            const double plane = side ? g->x0[a] + g->L[a] : g->x0[a];
+            for (int i = 0; i < dem_count(d); i++)
+                if (!fixed[i] && (side ? plane - (x[3 * i + a] + r[i]) : x[3 * i + a] - r[i] - plane) < 0) {
+                    *face_name = face[a][side];
+                    return dem_ids(d)[i] + 1;
+                }
+        }
+    return 0;
+}
+
+/* Such a contact stops the run (sim.h, halt). */
+static int part_halt(void *ctx, char *why, size_t n)
+{
+    coupling_part_t *cp = ctx;
+    if (!cp->ibm) return 0;
+    setup(cp);
+    const char *face;
+    const long id = unwalled_touch(cp->d, cp->ibm->g, &face);
+    if (id)
+        snprintf(why, n, "particle %ld touched the %s face of the fluid's domain, which has no DEM wall (give it one "
+                 "with walls.faces)", id, face);
+    return id != 0;
+}
+
 static void part_destroy(void *ctx)
 {
     coupling_part_t *cp = ctx;
     coupling_freeze_free(&cp->fz);
     coupling_added_mass_free(&cp->am);
+    coupling_drag_free(&cp->drag);
     restitution_free(&cp->rest);
+    free(cp->prev_fz);
+    free(cp->prev_dU);
+    free(cp->prev_traj);
     free(cp);
 }
 
@@ -419,22 +559,34 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
     if (ibm && ibm->n > 0 && cfg_enum(cfg, "coupling", "added_mass") == 1)
         coupling_added_mass_init(&cp->am, ibm->n, cfg_double(cfg, "coupling", "added_mass_coefficient"));
     cp->stop_after = mode != RESTITUTION_OFF && cfg_bool(cfg, "coupling", "stop_after_rebound");
+    if (ibm && ibm->n > 0 && cfg_double(cfg, "coupling", "implicit_drag") > 0)
+        coupling_drag_init(&cp->drag, ibm->n, cfg_double(cfg, "coupling", "implicit_drag"),
+                           s->fluid->prm.rho * s->fluid->prm.nu);
     /* the lubrication correction adds what the grid does not resolve: it needs the grid spacing
      * (before the packing preparation, whose lists must hold every lubricated pair) */
     if (ibm) dem_lubrication_set_grid(sim_dem_engine_unprepared(s), grid_min_spacing(s->fluid->g));
+    const char *face;
+    const long id = ibm ? unwalled_touch(sim_dem_engine_unprepared(s), ibm->g, &face) : 0;
+    if (id)
+        cfg_fail(cfg, "walls", "faces", "particle %ld crosses the %s face of the fluid's domain, which has no DEM wall: "
+                 "it would halt the run at once", id, face);
     sim_part_t part = {
         .name = "coupling",
         .ctx = cp,
+        .stable_dt = part_stable_dt,
         .align_dt = part_align_dt,
         .advance = part_advance,
         .ncol = mode ? 2 : 0,
         .col_names = rest_cols,
         .diagnostics = part_diagnostics,
         .diverged = part_diverged,
+        .keep_previous = part_keep_previous,
+        .restore_previous = part_restore_previous,
         .checkpoint_write = part_checkpoint_write,
         .checkpoint_read = part_checkpoint_read,
         .summary = part_summary,
         .done = part_done,
+        .halt = part_halt,
         .destroy = part_destroy,
     };
     sim_add_part(s, &part);

@@ -31,6 +31,7 @@ typedef struct {
     int snap_first;      /* index of the first snapshot of this run */
     int snap_resumed;
     dem_status_t status; /* of the last advance */
+    dem_state_t *prev;   /* the state at the start of the step (rollback) */
     double wall, psteps; /* wall time in dem_advance and particle-steps done */
 } dem_part_t;
 
@@ -91,6 +92,20 @@ static int part_diverged(void *ctx, char *why, size_t n)
     return 1;
 }
 
+static void part_keep_previous(void *ctx)
+{
+    dem_part_t *dp = ctx;
+    dp->prev = dem_state_save(dp->d, dp->prev);
+}
+
+static void part_restore_previous(void *ctx)
+{
+    dem_part_t *dp = ctx;
+    if (!dp->prev) return;
+    dem_state_restore(dp->d, dp->prev);
+    dp->status = DEM_OK;
+}
+
 static double part_change_rate(void *ctx, double dt)
 {
     dem_part_t *dp = ctx;
@@ -127,6 +142,10 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
     dem_checkpoint_read_loc(dp->d, grp, path);
     long snaps = 0;
     if (io_h5_get_attr_long(grp, "snapshots", &snaps) == 0) dp->snap_first = (int)snaps;
+    /* the snapshots the lost continuation wrote, and the index of ours */
+    io_outdir_remove_numbered(&dp->sim->out, "particles_", ".h5", dp->snap_first);
+    dem_snapshots_resume(dp->d, dp->sim->out.dir, dp->snap_first);
+    dp->snap_resumed = 1;
     dp->prepared = 1;
     const dem_status_t st = dem_advance(dp->d, dem_time(dp->d));
     if (st != DEM_OK) die("dem: %s", dem_error(dp->d));
@@ -158,6 +177,7 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
 static void part_destroy(void *ctx)
 {
     dem_part_t *dp = ctx;
+    dem_state_free(dp->prev);
     dem_free(dp->d);
     free(dp);
 }
@@ -204,6 +224,7 @@ void sim_add_dem(sim_t *s, cfg_t *cfg)
     const fluid_model_t model = fluid_model_of(cfg);
     dp->with_fluid = model == FLUID_MODEL_RESOLVED || model == FLUID_MODEL_PORENET;
     if (dem_count(dp->d) == 0) cfg_fail(cfg, "particles", "source", "the scene has no particles");
+    if (cfg_bool(cfg, "packing", "prepare")) sim_add_output_name(s, cfg_string(cfg, "packing", "output"));
     sim_part_t part = {
         .name = "dem",
         .ctx = dp,
@@ -213,6 +234,8 @@ void sim_add_dem(sim_t *s, cfg_t *cfg)
         .col_names = dem_cols,
         .diagnostics = part_diagnostics,
         .diverged = part_diverged,
+        .keep_previous = part_keep_previous,
+        .restore_previous = part_restore_previous,
         .change_rate = part_change_rate,
         .write_fields = part_write_fields,
         .checkpoint_write = part_checkpoint_write,

@@ -17,7 +17,12 @@ typedef struct {
     double *prev[4];      /* u, v, w, p at the start of the step (rollback) */
     double prev_time;
     long prev_step;
+    fluid_diag_t prev_diag; /* the diagnostics of the step before */
+    int prev_stepped;
+    long prev_implicit_steps;
     double ke_now, ke_prev; /* kinetic energy after and before the last step */
+    double ke_still;        /* ½ V u_s², u_s = 0.1 CFL target × smallest cell / the last step (part_diverged) */
+    double volume, hmin;    /* of the domain (axisymmetric: 2π included), smallest cell size */
     double div_init;      /* max |div u| of the initial state */
     int stepped;          /* a step was taken in this run */
     io_snapshots_t *snaps;
@@ -54,6 +59,8 @@ static void part_advance(void *ctx, double dt)
 {
     fluid_part_t *fp = ctx;
     fp->ke_prev = fp->ke_now;
+    const double us = 0.1 * fp->f->prm.cfl * fp->hmin / dt;
+    fp->ke_still = 0.5 * fp->volume * us * us;
     const int was_implicit = fp->f->implicit_step;
     fluid_step(fp->f, dt);
     report_viscous(fp, was_implicit, dt);
@@ -84,7 +91,11 @@ static void part_diagnostics(void *ctx, double *c)
  * makes the kinetic energy non-finite; one in p reaches u and the residual),
  * when its CFL number is above the hard limit (beyond the stability of RK3
  * with central advection, |λΔt| ≤ √3, the solution is noise), or when the
- * kinetic energy jumps by a large factor in one step (an instability). */
+ * kinetic energy jumps by a large factor in one step (an instability).  The
+ * jump is counted from at least the energy of a field still at the scale of
+ * the step (ke_still: a speed of a tenth of the CFL target's everywhere): a fluid
+ * set in motion from rest by particles that the DEM accelerated over a step
+ * gains far more than the factor in one step without any instability. */
 static int part_diverged(void *ctx, char *why, size_t n)
 {
     fluid_part_t *fp = ctx;
@@ -105,7 +116,7 @@ static int part_diverged(void *ctx, char *why, size_t n)
         snprintf(why, n, "CFL = %.4g is above the hard limit %.4g (%s)", d->cfl, limit, src);
         return 1;
     }
-    if (fp->ke_prev > 0 && fp->ke_now > sp->ke_growth_abort * fp->ke_prev) {
+    if (fp->ke_prev > 0 && fp->ke_now > sp->ke_growth_abort * fmax(fp->ke_prev, fp->ke_still)) {
         snprintf(why, n, "the kinetic energy grew by a factor %.4g in one step (limit: time.ke_growth_abort = %g)",
                  fp->ke_now / fp->ke_prev, sp->ke_growth_abort);
         return 1;
@@ -125,6 +136,9 @@ static void part_keep_previous(void *ctx)
     }
     fp->prev_time = f->time;
     fp->prev_step = f->step;
+    fp->prev_diag = f->diag;
+    fp->prev_stepped = fp->stepped;
+    fp->prev_implicit_steps = f->implicit_steps;
 }
 
 static void part_restore_previous(void *ctx)
@@ -137,6 +151,9 @@ static void part_restore_previous(void *ctx)
     }
     f->time = fp->prev_time;
     f->step = fp->prev_step;
+    f->diag = fp->prev_diag;
+    fp->stepped = fp->prev_stepped;
+    f->implicit_steps = fp->prev_implicit_steps;
     fp->ke_now = fp->ke_prev;
 }
 
@@ -184,6 +201,9 @@ static void part_checkpoint_write(void *ctx, hid_t grp)
     io_h5_attr_double(grp, "time", f->time);
     io_h5_attr_long(grp, "step", f->step);
     io_h5_attr_long(grp, "snapshots", fp->snaps ? io_snapshots_count(fp->snaps) : fp->snap_first);
+    /* the diagnostics of the last step (a restart that takes no step reports them) */
+    const double diag[5] = {fp->stepped, f->diag.cfl, f->diag.div_max, f->diag.res_poisson, f->diag.it_poisson};
+    io_h5_write_array(grp, "last_step_diagnostics", 5, diag);
     io_h5_attr_long(grp, "implicit_steps", f->implicit_steps);
     io_h5_attr_string(grp, "layout", "interior of each staggered field, [nx][ny][nz], k fastest; "
                                      "u(i) on the high x face of cell i (CaNS convention)");
@@ -263,11 +283,21 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
     if (io_h5_get_attr_double(grp, "time", &f->time) || io_h5_get_attr_long(grp, "step", &f->step))
         die("%s: /fluid has no time or step attribute", path);
     if (io_h5_get_attr_long(grp, "snapshots", &snaps) == 0) fp->snap_first = (int)snaps;
+    /* the snapshots the lost continuation wrote, and the index of ours */
+    io_outdir_remove_numbered(&fp->sim->out, "fields_", ".h5", fp->snap_first);
+    if (!fp->snaps) fp->snaps = io_snapshots_create(fp->g, fp->sim->out.dir, fp->snap_first);
+    io_snapshots_write_index(fp->snaps);
     if (io_h5_get_attr_long(grp, "implicit_steps", &f->implicit_steps)) f->implicit_steps = 0;
     fluid_apply_bc(f);
     fill_pressure_ghosts(fp->g, f->p);
     fp->ke_now = fluid_kinetic_energy(f);
     fp->div_init = fluid_max_divergence(f);
+    double diag[5];
+    if (io_h5_read_array(grp, "last_step_diagnostics", 5, diag) == 5) {
+        fp->stepped = diag[0] != 0;
+        f->diag.cfl = diag[1], f->diag.div_max = diag[2], f->diag.res_poisson = diag[3];
+        f->diag.it_poisson = (int)diag[4];
+    }
 }
 
 static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
@@ -323,6 +353,9 @@ void sim_add_fluid(sim_t *s, cfg_t *cfg)
     fluid_apply_bc(fp->f);
     fp->ke_now = fluid_kinetic_energy(fp->f);
     fp->div_init = fluid_max_divergence(fp->f);
+    const grid_t *g = fp->g;
+    fp->hmin = grid_min_spacing(g);
+    fp->volume = g->geom == GEOM_AXI ? M_PI * g->L[0] * g->L[0] * g->L[1] : g->L[0] * g->L[1] * (g->dim == 3 ? g->L[2] : 1.0);
     s->fluid = fp->f;
     sim_part_t part = {
         .name = "fluid",

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "ibm.h"
+#include "overlap.h"
 #include "sim.h"
 #include "util.h"
 
@@ -29,6 +30,7 @@ typedef struct {
     double *snap_time;
     int snap_cap;
     io_series_t *csv;     /* spheres.csv (rank 0) */
+    long csv_last_step;   /* step of its last rows (-1: none) */
     double *cell;         /* scratch field for the solid fraction */
     double wall_steps;    /* wall time of the fluid steps of this run */
 } ibm_part_t;
@@ -102,6 +104,59 @@ static int part_diverged(void *ctx, char *why, size_t n)
     return 0;
 }
 
+/* A free sphere touching a wall or another sphere: the immersed boundary
+ * has no contact model (the fluid alone would let it sink slowly through),
+ * so the run stops there (sim.h, halt).  Contacts need the DEM: spheres given
+ * as [particles] of a coupled scene. */
+static int part_halt(void *ctx, char *why, size_t n)
+{
+    ibm_part_t *ip = ctx;
+    const ibm_t *ibm = ip->ibm;
+    const grid_t *g = ibm->g;
+    static const char *face[3][2] = {{"x_lo", "x_hi"}, {"y_lo", "y_hi"}, {"z_lo", "z_hi"}};
+    int nfree = 0;
+    for (int p = 0; p < ibm->n; p++) {
+        const ibm_sphere_t *s = &ibm->s[p];
+        if (s->kind != IBM_FREE) continue;
+        nfree++;
+        for (int d = 0; d < g->dim; d++)
+            for (int side = 0; side < 2; side++) {
+                if (g->bc.type[d][side] == BC_PERIODIC || g->bc.type[d][side] == BC_AXIS) continue;
+                const double gap = side ? g->x0[d] + g->L[d] - (s->x[d] + s->radius) : s->x[d] - s->radius - g->x0[d];
+                if (gap < 0) {
+                    snprintf(why, n, "free sphere %d touched the %s wall (%c = %g, radius %g): immersed spheres have "
+                             "no contact model (give them one as [particles] of a coupled scene)", p + 1,
+                             face[d][side], "xyz"[d], s->x[d], s->radius);
+                    return 1;
+                }
+            }
+    }
+    if (nfree == 0 || ibm->n < 2) return 0;
+    overlap_box_t box = {.dim = g->dim};
+    double *x = xcalloc(3 * (size_t)ibm->n, sizeof(double)), *r = xcalloc((size_t)ibm->n, sizeof(double));
+    unsigned char *act = xcalloc((size_t)ibm->n, 1);
+    for (int d = 0; d < 3; d++) {
+        box.lo[d] = g->x0[d];
+        box.L[d] = g->L[d];
+        box.periodic[d] = g->periodic[d];
+    }
+    for (int p = 0; p < ibm->n; p++) {
+        memcpy(&x[3 * p], ibm->s[p].x, 3 * sizeof(double));
+        r[p] = ibm->s[p].radius;
+        act[p] = ibm->s[p].kind == IBM_FREE;
+    }
+    int i = 0, j = 0;
+    double delta = 0;
+    const int hit = overlap_find(&box, ibm->n, x, r, act, 0.0, &i, &j, &delta);
+    free(x);
+    free(r);
+    free(act);
+    if (hit)
+        snprintf(why, n, "spheres %d and %d touched (overlap %.3g): immersed spheres have no contact model (give them "
+                 "one as [particles] of a coupled scene)", i + 1, j + 1, delta);
+    return hit;
+}
+
 static void part_keep_previous(void *ctx)
 {
     ibm_part_t *ip = ctx;
@@ -147,12 +202,8 @@ static void write_xmf(const ibm_part_t *ip)
     if (mpi_rank() != 0) return;
     char path[IO_PATH_MAX + 32], tmp[IO_PATH_MAX + 40];
     snprintf(path, sizeof path, "%s/spheres.xmf", ip->sim->out.dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
-        warn("cannot write %s\n", tmp);
-        return;
-    }
+    FILE *f = atomic_open(path, tmp, sizeof tmp);
+    if (!f) return;
     int n = ip->ibm->n;
     fprintf(f, "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"2.0\">\n"
                "  <Domain>\n  <Grid Name=\"spheres\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
@@ -180,8 +231,7 @@ static void write_xmf(const ibm_part_t *ip)
         fprintf(f, "    </Grid>\n");
     }
     fprintf(f, "  </Grid>\n  </Domain>\n</Xdmf>\n");
-    fclose(f);
-    rename(tmp, path);
+    atomic_commit(f, tmp, path);
 }
 
 /* Per-sphere arrays: 3-vectors [n][3] and scalars [n]. */
@@ -225,6 +275,16 @@ static void write_sphere_arrays(const ibm_t *ibm, hid_t loc, int full)
     free(buf);
 }
 
+/* spheres.csv (collective): a new file, or (r) the one a restart continues */
+static void open_csv(ibm_part_t *ip, const io_series_resume_t *r)
+{
+    static const char *names[] = {"step", "time", "sphere", "x",  "y",  "z",  "u",  "v",  "w",
+                                  "ox",   "oy",   "oz",     "fx", "fy", "fz", "tx", "ty", "tz"};
+    char path[IO_PATH_MAX + 32];
+    snprintf(path, sizeof path, "%s/spheres.csv", ip->sim->out.dir);
+    ip->csv = io_series_open(path, 18, names, r);
+}
+
 static void part_write_fields(void *ctx, double time, long step)
 {
     ibm_part_t *ip = ctx;
@@ -245,13 +305,7 @@ static void part_write_fields(void *ctx, double time, long step)
     ip->snap_time[ip->nsnap++] = time;
     write_xmf(ip);
     /* spheres.csv: one row per sphere */
-    if (!ip->csv) {
-        static const char *names[] = {"step", "time", "sphere", "x",  "y",  "z",  "u",  "v",  "w",
-                                      "ox",   "oy",   "oz",     "fx", "fy", "fz", "tx", "ty", "tz"};
-        char p2[IO_PATH_MAX + 32];
-        snprintf(p2, sizeof p2, "%s/spheres.csv", ip->sim->out.dir);
-        ip->csv = io_series_open(p2, 18, names, ip->sim->restart_path[0] ? ip->sim->step0 : -1);
-    }
+    if (!ip->csv) open_csv(ip, NULL);
     for (int p = 0; p < ibm->n; p++) {
         const ibm_sphere_t *s = &ibm->s[p];
         double row[18] = {(double)step, time, p + 1};
@@ -264,6 +318,7 @@ static void part_write_fields(void *ctx, double time, long step)
         }
         io_series_row(ip->csv, row);
     }
+    ip->csv_last_step = step;
 }
 
 static void part_checkpoint_write(void *ctx, hid_t grp)
@@ -271,6 +326,8 @@ static void part_checkpoint_write(void *ctx, hid_t grp)
     ibm_part_t *ip = ctx;
     io_h5_attr_long(grp, "spheres", ip->ibm->n);
     io_h5_attr_long(grp, "snapshots", ip->nsnap);
+    io_h5_attr_long(grp, "csv_last_step", ip->csv_last_step);
+    if (ip->csv) io_h5_attr_hash(grp, "csv_hash", io_series_hash(ip->csv, ip->sim->step), ip->ibm->g->comm);
     write_sphere_arrays(ip->ibm, grp, 1);
     double *h = xcalloc((size_t)ip->ibm->n + 1, sizeof(double));
     for (int p = 0; p < ip->ibm->n; p++) h[p] = ip->ibm->s[p].history;
@@ -312,6 +369,14 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
         if (io_h5_read_array(grp, "snapshot_times", ns, ip->snap_time) != ns) die("%s: /ibm/snapshot_times", path);
         ip->nsnap = (int)ns;
     }
+    io_series_resume_t r = {ip->sim->step, -1, 0, 0};
+    if (io_h5_get_attr_long(grp, "csv_last_step", &r.last_row)) r.last_row = -1;
+    r.has_hash = io_h5_get_attr_hash(grp, "csv_hash", &r.hash) == 0;
+    ip->csv_last_step = r.last_row;
+    if (!ip->csv) open_csv(ip, &r); /* cut after the checkpoint's rows, checked */
+    /* the snapshots the lost continuation wrote, and the index of ours */
+    io_outdir_remove_numbered(&ip->sim->out, "spheres_", ".h5", ip->nsnap);
+    write_xmf(ip);
     ibm_rebuild_geometry(ibm);
 }
 
@@ -367,6 +432,7 @@ struct ibm *sim_add_ibm_with(sim_t *s, cfg_t *cfg, const void *extra, int nextra
 {
     ibm_part_t *ip = xcalloc(1, sizeof *ip);
     ip->sim = s;
+    ip->csv_last_step = -1;
     ip->ibm = ibm_create_from_config_with(cfg, s->fluid, extra, nextra);
     const grid_t *g = ip->ibm->g;
     ip->nseries = cfg_int(cfg, "ibm", "series_spheres");
@@ -395,6 +461,7 @@ struct ibm *sim_add_ibm_with(sim_t *s, cfg_t *cfg, const void *extra, int nextra
         .checkpoint_write = part_checkpoint_write,
         .checkpoint_read = part_checkpoint_read,
         .summary = part_summary,
+        .halt = part_halt,
         .destroy = part_destroy,
     };
     sim_add_part(s, &part);

@@ -169,7 +169,9 @@ static long dry_steps;
 static void dry_run(oedo_t *o, long n)
 {
     const double c = cputime();
-    if (dem_run_steps(o->d, n) != DEM_OK) die("oedometer: the dry sample: %s", dem_error(o->d));
+    /* before the first step: parameters that cannot carry the load are bad input */
+    if (dem_run_steps(o->d, n) != DEM_OK)
+        cfg_fail(o->cfg, "oedometer", "preload", "the dry sample under the load: %s", dem_error(o->d));
     dry_cpu += cputime() - c;
     dry_steps += n;
 }
@@ -186,7 +188,8 @@ static double relax(oedo_t *o)
         if (k > 3 && fabs(h1 - h) < o->rest_tol) return o->ntop > 0 ? surface_z(o) : h1;
         h = h1;
     }
-    die("oedometer: the dry sample did not come to rest (oedometer.rest_tolerance = %g m per 100 steps)", o->rest_tol);
+    cfg_fail(o->cfg, "oedometer", "rest_tolerance", "the dry sample did not come to rest (%g m per 100 steps)",
+             o->rest_tol);
 }
 
 /* The load raised linearly to sigma over n × 100 steps (n = 0: at once), then to rest. */

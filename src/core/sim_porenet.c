@@ -36,6 +36,15 @@ typedef struct {
     double *xp, *rp;    /* the fixed packing read from porenet.packing */
     double q[6];
     double kappa[3];
+    cfg_t *cfg;         /* the input: a network that cannot be built from it at the start is bad input */
+    int failed;         /* the last step failed (m.err): the run diverged */
+    /* the state at the start of the step (rollback) */
+    struct {
+        long n_retri, n_steps;
+        int vol_current, npore, n;
+        double eps_acc, q[6], kappa[3];
+        double *p, *vol, *vol_prev, *x_prev, *f, *x_tri;
+    } prev;
     int snapshots;      /* write the network at the run's snapshot times */
     void (*before_start)(void *ctx); /* called once before the first solve (sim_porenet_before_start) */
     void *before_ctx;
@@ -71,7 +80,10 @@ static int read_packing_h5(cfg_t *cfg, const char *path, porenet_part_t *pp)
         cfg_fail(cfg, "porenet", "packing", "%s: position must hold 3 values per radius", path);
     H5Fclose(f);
     for (long i = 0; i < n; i++)
-        if (!(pp->rp[i] > 0)) cfg_fail(cfg, "porenet", "packing", "%s: radius %ld is not positive", path, i);
+        if (!(pp->rp[i] > 0) || !isfinite(pp->rp[i]) || !isfinite(pp->xp[3 * i]) || !isfinite(pp->xp[3 * i + 1]) ||
+            !isfinite(pp->xp[3 * i + 2]))
+            cfg_fail(cfg, "porenet", "packing", "%s: sphere %ld: the radius must be positive, every value finite", path,
+                     i + 1);
     return (int)n;
 }
 
@@ -80,26 +92,34 @@ static int read_packing_text(cfg_t *cfg, const char *path, porenet_part_t *pp)
 {
     FILE *f = fopen(path, "r");
     if (!f) cfg_fail(cfg, "porenet", "packing", "cannot open %s", path);
-    char line[1024];
+    char *line = NULL;
+    size_t lcap = 0;
     int cap = 1024, n = 0, ln = 0;
     pp->xp = malloc(3 * (size_t)cap * sizeof *pp->xp);
     pp->rp = malloc((size_t)cap * sizeof *pp->rp);
-    while (fgets(line, sizeof line, f)) {
+    while (getline(&line, &lcap, f) > 0) {
         ln++;
         char *s = line;
         while (*s == ' ' || *s == '\t') s++;
-        if (*s == '#' || *s == '\n' || *s == 0) continue;
+        if (*s == '#' || *s == '\n' || *s == '\r' || *s == 0) continue;
         if (n == cap) {
             cap *= 2;
             pp->xp = realloc(pp->xp, 3 * (size_t)cap * sizeof *pp->xp);
             pp->rp = realloc(pp->rp, (size_t)cap * sizeof *pp->rp);
         }
-        if (sscanf(s, "%lf %lf %lf %lf", pp->xp + 3 * n, pp->xp + 3 * n + 1, pp->xp + 3 * n + 2, pp->rp + n) != 4 ||
-            !(pp->rp[n] > 0))
-            cfg_fail(cfg, "porenet", "packing", "%s:%d: expected x y z r with r > 0", path, ln);
+        double v[4];
+        int k = 0;
+        char *save = NULL;
+        for (char *tok = strtok_r(s, " \t\r\n", &save); tok && k <= 4; tok = strtok_r(NULL, " \t\r\n", &save), k++)
+            if (k == 4 || !cfg_parse_real(tok, &v[k])) k = 5;
+        if (k != 4 || !(v[3] > 0))
+            cfg_fail(cfg, "porenet", "packing", "%s:%d: expected four numbers x y z r with r > 0", path, ln);
+        for (int c = 0; c < 3; c++) pp->xp[3 * n + c] = v[c];
+        pp->rp[n] = v[3];
         n++;
     }
     fclose(f);
+    free(line);
     return n;
 }
 
@@ -119,17 +139,20 @@ static void after_solve(porenet_part_t *pp)
     for (int a = 0; a < 3; a++) pp->kappa[a] = pn_model_permeability(&pp->m, a);
 }
 
-/* dt <= 0: the initial state (rigid skeleton) */
-static void solve_now(porenet_part_t *pp, double dt)
+/* dt <= 0: the initial state (rigid skeleton).  Returns 0, or -1 with the
+ * reason in pp->m.err. */
+static int solve_now(porenet_part_t *pp, double dt)
 {
     if (pp->with_dem) {
-        if (pn_model_couple_dem(&pp->m, pp->d, pp->g, dt)) die("porenet: %s", pp->m.err);
+        if (pn_model_couple_dem(&pp->m, pp->d, pp->g, dt)) return -1;
         pp->n = pp->m.n;
         pp->x = pp->m.xid;
         pp->r = pp->m.rid;
-    } else if (pn_model_step(&pp->m, pp->n, pp->x, pp->r, 0.0))
-        die("porenet: %s", pp->m.err);
+    } else if (pn_model_step(&pp->m, pp->n, pp->x, pp->r, 0.0)) {
+        return -1;
+    }
     after_solve(pp);
+    return 0;
 }
 
 /* Arithmetic mean diameter of the spheres (κ/d²). */
@@ -148,7 +171,12 @@ static void ensure_started(porenet_part_t *pp)
     pp->started = 1;
     if (pp->before_start) pp->before_start(pp->before_ctx);
     if (pp->with_dem) pp->d = sim_dem_engine(pp->sim);
-    solve_now(pp, 0.0);
+    if (solve_now(pp, 0.0)) {
+        if (!pp->with_dem) cfg_fail(pp->cfg, "porenet", "packing", "%s", pp->m.err);
+        const int margin = strstr(pp->m.err, "margin") != NULL;
+        cfg_fail(pp->cfg, margin ? "porenet" : "particles", margin ? "margin" : "source",
+                 "the network of the first packing cannot be built: %s", pp->m.err);
+    }
     double re, sr, por;
     char wbuf[1024];
     if (pn_model_validity(&pp->m, pp->r, wbuf, sizeof wbuf, &re, &sr, &por)) warn("porenet: outside the model's validity:\n%s", wbuf);
@@ -181,7 +209,7 @@ static void part_advance(void *ctx, double dt)
     porenet_part_t *pp = ctx;
     ensure_started(pp);
     /* fixed packing: the same steady solution (boundary values may change on restart) */
-    solve_now(pp, pp->with_dem ? dt : 0.0);
+    pp->failed = solve_now(pp, pp->with_dem ? dt : 0.0) != 0;
 }
 
 static void part_diagnostics(void *ctx, double *c)
@@ -202,12 +230,81 @@ static void part_diagnostics(void *ctx, double *c)
 static int part_diverged(void *ctx, char *why, size_t n)
 {
     porenet_part_t *pp = ctx;
+    if (pp->failed) {
+        snprintf(why, n, "%s", pp->m.err);
+        return 1;
+    }
     for (int i = 0; i < pp->m.net.npore; i++)
         if (!isfinite(pp->m.p[i])) {
             snprintf(why, n, "non-finite pore pressure");
             return 1;
         }
     return 0;
+}
+
+/* ---- the state: rollback and checkpoints ---- */
+
+static double *copy_of(double *dst, const double *src, size_t n)
+{
+    dst = realloc(dst, (n ? n : 1) * sizeof *dst);
+    if (n) memcpy(dst, src, n * sizeof *dst);
+    return dst;
+}
+
+static void part_keep_previous(void *ctx)
+{
+    porenet_part_t *pp = ctx;
+    ensure_started(pp);
+    pn_model_t *m = &pp->m;
+    const size_t np = (size_t)m->net.npore, n3 = 3 * (size_t)m->n;
+    pp->prev.n_retri = m->n_retri;
+    pp->prev.n_steps = m->n_steps;
+    pp->prev.vol_current = m->vol_current;
+    pp->prev.npore = m->net.npore;
+    pp->prev.n = m->n;
+    pp->prev.eps_acc = m->eps_acc;
+    memcpy(pp->prev.q, pp->q, sizeof pp->q);
+    memcpy(pp->prev.kappa, pp->kappa, sizeof pp->kappa);
+    pp->prev.p = copy_of(pp->prev.p, m->p, np);
+    pp->prev.vol = copy_of(pp->prev.vol, m->vol, np);
+    pp->prev.vol_prev = copy_of(pp->prev.vol_prev, m->vol_prev, np);
+    pp->prev.x_prev = copy_of(pp->prev.x_prev, m->x_prev, n3);
+    pp->prev.f = copy_of(pp->prev.f, m->f, n3);
+    pp->prev.x_tri = copy_of(pp->prev.x_tri, m->x_tri, n3);
+}
+
+/* The model's state from saved values: the triangulation, network and
+ * factorisation rebuilt from the positions they were built from when they
+ * are not those (then: the same, bit for bit), and the step's values. */
+static void set_state(porenet_part_t *pp, long n_retri, long n_steps, int vol_current, double eps_acc,
+                      const double *x_tri, const double *p, const double *vol, const double *vol_prev,
+                      const double *x_prev, const double *f)
+{
+    pn_model_t *m = &pp->m;
+    const int n = m->n;
+    const double *r = pp->with_dem ? m->rid : pp->r;
+    if (!m->built || !m->sol || n_retri != m->n_retri || memcmp(x_tri, m->x_tri, 3 * (size_t)n * sizeof *x_tri))
+        if (pn_model_rebuild(m, n, x_tri, r)) die("porenet: %s", m->err);
+    const size_t np = (size_t)m->net.npore, n3 = 3 * (size_t)n;
+    memcpy(m->p, p, np * sizeof *p);
+    memcpy(m->vol, vol, np * sizeof *vol);
+    memcpy(m->vol_prev, vol_prev, np * sizeof *vol_prev);
+    memcpy(m->x_prev, x_prev, n3 * sizeof *x_prev);
+    memcpy(m->f, f, n3 * sizeof *f);
+    m->n_retri = n_retri;
+    m->n_steps = n_steps;
+    m->vol_current = vol_current;
+    m->eps_acc = eps_acc;
+}
+
+static void part_restore_previous(void *ctx)
+{
+    porenet_part_t *pp = ctx;
+    set_state(pp, pp->prev.n_retri, pp->prev.n_steps, pp->prev.vol_current, pp->prev.eps_acc, pp->prev.x_tri,
+              pp->prev.p, pp->prev.vol, pp->prev.vol_prev, pp->prev.x_prev, pp->prev.f);
+    memcpy(pp->q, pp->prev.q, sizeof pp->q);
+    memcpy(pp->kappa, pp->prev.kappa, sizeof pp->kappa);
+    pp->failed = 0; /* the DEM part brought back its external forces */
 }
 
 static void part_write_fields(void *ctx, double time, long step)
@@ -237,6 +334,9 @@ static void part_checkpoint_read(void *ctx, hid_t g, const char *path)
     pn_model_gather(&pp->m, pp->d);
     if (pn_model_state_read(&pp->m, g, dem_count(pp->d), pp->m.rid)) die("%s: porenet: %s", path, pp->m.err);
     if (!pp->m.built) die("%s: porenet: the checkpoint holds no network", path);
+    /* the snapshots the lost continuation wrote, and the index of ours */
+    io_outdir_remove_numbered(&pp->sim->out, "porenet_", ".h5", pp->m.nsnap);
+    pn_write_index(&pp->m, pp->sim->out.dir);
     pn_model_apply_forces(&pp->m, pp->d, pp->g);
     pp->n = pp->m.n;
     pp->x = pp->m.xid;
@@ -301,6 +401,8 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
 static void part_destroy(void *ctx)
 {
     porenet_part_t *pp = ctx;
+    double *prev[] = {pp->prev.p, pp->prev.vol, pp->prev.vol_prev, pp->prev.x_prev, pp->prev.f, pp->prev.x_tri};
+    for (size_t i = 0; i < sizeof prev / sizeof prev[0]; i++) free(prev[i]);
     pn_model_free(&pp->m);
     free(pp->xp);
     free(pp->rp);
@@ -311,6 +413,7 @@ void sim_add_porenet(sim_t *s, cfg_t *cfg)
 {
     porenet_part_t *pp = xcalloc(1, sizeof *pp);
     pp->sim = s;
+    pp->cfg = cfg;
     pn_model_from_config(cfg, &pp->m);
     pp->with_dem = cfg_has_section(cfg, "particles");
     const int snaps = cfg_enum(cfg, "porenet", "snapshots");
@@ -324,6 +427,16 @@ void sim_add_porenet(sim_t *s, cfg_t *cfg)
         for (int f = 0; f < 6; f++)
             if ((cfg_enum(cfg, "boundary", fn[f]) == 0) != pp->m.dom.periodic[f / 2])
                 cfg_fail(cfg, "porenet", fn[f], "must be periodic exactly when boundary.%s is (the DEM's face)", fn[f]);
+        /* the network's images of the spheres must fit in the box (pn_triangulate) */
+        const dem_t *d = sim_dem_engine_unprepared(s);
+        double rmax = 0;
+        for (int i = 0; d && i < dem_count(d); i++) rmax = fmax(rmax, dem_radii(d)[i]);
+        const double margin = pp->m.margin > 0 ? pp->m.margin : 6 * rmax;
+        for (int a = 0; a < 3; a++)
+            if (margin >= pp->m.dom.hi[a] - pp->m.dom.lo[a])
+                cfg_fail(cfg, pp->m.margin > 0 ? "porenet" : "domain", pp->m.margin > 0 ? "margin" : "length",
+                         "the box length along %c (%g) is not larger than the network's image margin %g%s", 'x' + a,
+                         pp->m.dom.hi[a] - pp->m.dom.lo[a], margin, pp->m.margin > 0 ? "" : " (3 largest diameters)");
     } else {
         read_packing(cfg, pp);
         ensure_started(pp);
@@ -337,6 +450,8 @@ void sim_add_porenet(sim_t *s, cfg_t *cfg)
         .col_names = pn_cols,
         .diagnostics = part_diagnostics,
         .diverged = part_diverged,
+        .keep_previous = part_keep_previous,
+        .restore_previous = part_restore_previous,
         .write_fields = part_write_fields,
         /* a fixed packing is solved once: nothing to restart from */
         .checkpoint_write = pp->with_dem ? part_checkpoint_write : NULL,

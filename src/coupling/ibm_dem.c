@@ -152,3 +152,85 @@ void coupling_motion_to_ibm(const dem_t *d, ibm_t *ibm)
     }
     ibm_update_geometry(ibm);
 }
+
+void coupling_drag_init(coupling_drag_t *dr, int n, double k, double mu)
+{
+    dr->n = n;
+    dr->k = k;
+    dr->mu = mu;
+    dr->held = xcalloc(6 * (size_t)(n > 0 ? n : 1), sizeof(double));
+    dr->chunks = 0;
+}
+
+void coupling_drag_free(coupling_drag_t *dr)
+{
+    free(dr->held);
+    memset(dr, 0, sizeof *dr);
+}
+
+/* c = K 3πηD and c_r = K πηD³ of a particle of radius r */
+static void drag_coefficients(const coupling_drag_t *dr, double r, double *c, double *cr)
+{
+    *c = dr->k * 6.0 * M_PI * dr->mu * r;
+    *cr = dr->k * 8.0 * M_PI * dr->mu * r * r * r;
+}
+
+dem_status_t coupling_drag_advance(coupling_drag_t *dr, const ibm_t *ibm, dem_t *d, coupling_added_mass_t *am,
+                                   double dt)
+{
+    const int np = dem_count(d);
+    const long *id = dem_ids(d);
+    const double *r = dem_radii(d);
+    const unsigned char *fixed = dem_fixed(d);
+    double *fe = dem_ext_force(d), *te = dem_ext_torque(d);
+    /* the held force and torque, by sphere (the DEM may reorder its particles between chunks),
+     * and the shortest relaxation time */
+    double tau = INFINITY;
+    for (int i = 0; i < np; i++) {
+        const long p = id[i];
+        for (int a = 0; a < 3; a++) {
+            dr->held[6 * p + a] = fe[3 * i + a];
+            dr->held[6 * p + 3 + a] = te[3 * i + a];
+        }
+        if (fixed[i]) continue;
+        double c, cr;
+        drag_coefficients(dr, r[i], &c, &cr);
+        const double mp = dem_density(d, i) * 4.0 / 3.0 * M_PI * r[i] * r[i] * r[i];
+        tau = fmin(tau, fmin(dem_mass(d, i) / c, 0.4 * mp * r[i] * r[i] / cr));
+    }
+    /* the steps dem_advance would take over dt, in chunks of at most 5 % of the relaxation time */
+    const double t0 = dem_time(d), ratio = dt / dem_dt(d);
+    long nsteps = lround(ratio);
+    if (nsteps < 1 || fabs(ratio - (double)nsteps) > 1e-6) nsteps = (long)ceil(ratio * (1 - 1e-12));
+    if (nsteps < 1) nsteps = 1;
+    const double per = 0.05 * tau / (dt / (double)nsteps); /* steps per chunk (inf: no mobile particle) */
+    long chunk = per < (double)nsteps ? (long)per : nsteps;
+    if (chunk < 1) chunk = 1;
+    dem_status_t st = DEM_OK;
+    for (long done = 0; done < nsteps && st == DEM_OK; done += chunk) {
+        const long next = done + chunk < nsteps ? done + chunk : nsteps;
+        const double span = (double)(next - done) * dt / (double)nsteps;
+        const int n = dem_count(d);
+        const long *idn = dem_ids(d);
+        const double *rn = dem_radii(d), *w = dem_omegas(d);
+        const unsigned char *fx = dem_fixed(d);
+        fe = dem_ext_force(d);
+        te = dem_ext_torque(d);
+        for (int i = 0; i < n; i++) {
+            const long p = idn[i];
+            const ibm_sphere_t *s = &ibm->s[p];
+            double U[3], c, cr;
+            dem_full_velocity(d, i, U);
+            drag_coefficients(dr, rn[i], &c, &cr);
+            for (int a = 0; a < 3; a++) {
+                const double F = fx[i] ? 0.0 : -c * (U[a] - s->u[a]);
+                fe[3 * i + a] = dr->held[6 * p + a] + F;
+                te[3 * i + a] = dr->held[6 * p + 3 + a] - (fx[i] ? 0.0 : cr * (w[3 * i + a] - s->omega[a]));
+                if (am && !fx[i]) am->slow[3 * p + a] += span * F / dem_mass(d, i);
+            }
+        }
+        st = dem_advance(d, next == nsteps ? t0 + dt : t0 + (double)next * dt / (double)nsteps);
+        dr->chunks++;
+    }
+    return st;
+}

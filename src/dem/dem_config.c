@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "dem_private.h"
+#include "io.h"
 #include "util.h"
 
 #define BIG 1e300
@@ -150,14 +151,14 @@ static void config_walls(dem_t *d, cfg_t *cfg)
     const int autow = !strcmp(faces, "auto"), none = !strcmp(faces, "none");
     if (!autow && !none) {
         /* every word must be a face name */
-        char buf[256];
-        snprintf(buf, sizeof buf, "%s", faces);
-        for (char *tok = strtok(buf, " ,"); tok; tok = strtok(NULL, " ,")) {
+        char *buf = strdup(faces), *save = NULL;
+        for (char *tok = strtok_r(buf, " \t,", &save); tok; tok = strtok_r(NULL, " \t,", &save)) {
             int ok = 0;
             for (int a = 0; a < 3; a++)
                 for (int s = 0; s < 2; s++) ok |= !strcmp(tok, face_names[a][s]);
-            if (!ok) cfg_fail(cfg, "walls", "faces", "'%s' is not auto, none or a face name (x_lo ... z_hi)", tok);
+            if (!ok) cfg_fail(cfg, "walls", "faces", "'%.40s' is not auto, none or a face name (x_lo ... z_hi)", tok);
         }
+        free(buf);
     }
     for (int a = 0; a < 3; a++)
         for (int s = 0; s < 2; s++) {
@@ -211,6 +212,12 @@ void dem_config_bed(dem_t *d, cfg_t *cfg)
     if (pos < d->lo[ax] || pos > d->hi[ax]) cfg_fail(cfg, "bed", "position", "outside the domain");
     const double L1 = d->L[a1], L2 = d->L[a2];
     const double v0[3] = {0, 0, 0};
+    /* grains no machine holds (the particle arrays take about 280 bytes a grain) */
+    const double expect = type == 2 ? floor(L1 / (2 * R) + 1e-9) * floor(L2 / (sqrt(3.0) * R) + 1e-9)
+                                    : cfg_double(cfg, "bed", "coverage") * L1 * L2 / (M_PI * R * R);
+    if (expect * 280.0 > physical_memory_bytes())
+        cfg_fail(cfg, "bed", "radius", "a bed of about %.3g grains needs more than the %.3g GB of memory of this machine",
+                 expect, physical_memory_bytes() / 1e9);
     if (type == 2) {
         /* hexagonal: rows along a1 with spacing 2R, rows 2R sin 60° apart */
         const int n1 = (int)floor(L1 / (2 * R) + 1e-9);
@@ -241,6 +248,13 @@ void dem_config_bed(dem_t *d, cfg_t *cfg)
     int nb = 0, maxcap = 1024;
     double *c1 = malloc(maxcap * sizeof(double)), *c2 = malloc(maxcap * sizeof(double)),
            *cr = malloc(maxcap * sizeof(double));
+    /* a grid of cells of at least the largest diameter: a disc can only meet
+     * the discs of its own and the 8 neighbouring cells (every cell when a
+     * direction has fewer than 3) */
+    const int m1 = (int)fmax(1.0, fmin(floor(L1 / (2 * R * (1 + poly))), fmax(1.0, sqrt(expect)))),
+              m2 = (int)fmax(1.0, fmin(floor(L2 / (2 * R * (1 + poly))), fmax(1.0, sqrt(expect))));
+    int *head = malloc((size_t)m1 * m2 * sizeof(int)), *next = malloc(maxcap * sizeof(int));
+    for (long c = 0; c < (long)m1 * m2; c++) head[c] = -1;
     long fails = 0;
     while (covered < cover * area) {
         const double r = R * (1 + poly * (2 * dem_rng_uniform(&g) - 1));
@@ -249,24 +263,41 @@ void dem_config_bed(dem_t *d, cfg_t *cfg)
             double p1 = d->lo[a1] + dem_rng_uniform(&g) * L1, p2 = d->lo[a2] + dem_rng_uniform(&g) * L2;
             if (!d->periodic[a1] && (p1 < d->lo[a1] + r || p1 > d->hi[a1] - r)) continue;
             if (!d->periodic[a2] && (p2 < d->lo[a2] + r || p2 > d->hi[a2] - r)) continue;
+            const int q1 = (int)fmin(m1 - 1, floor((p1 - d->lo[a1]) / L1 * m1)),
+                      q2 = (int)fmin(m2 - 1, floor((p2 - d->lo[a2]) / L2 * m2));
             int ok = 1;
-            for (int k = 0; k < nb && ok; k++) {
-                double e1 = p1 - c1[k], e2 = p2 - c2[k];
-                if (d->periodic[a1]) e1 -= L1 * round(e1 / L1);
-                if (d->periodic[a2]) e2 -= L2 * round(e2 / L2);
-                const double rr = r + cr[k];
-                if (e1 * e1 + e2 * e2 < rr * rr) ok = 0;
-            }
+            for (int o2 = m2 < 3 ? 0 : -1; o2 <= (m2 < 3 ? m2 - 1 : 1) && ok; o2++)
+                for (int o1 = m1 < 3 ? 0 : -1; o1 <= (m1 < 3 ? m1 - 1 : 1) && ok; o1++) {
+                    int k1 = m1 < 3 ? o1 : q1 + o1, k2 = m2 < 3 ? o2 : q2 + o2;
+                    if (k1 < 0 || k1 >= m1) {
+                        if (!d->periodic[a1]) continue;
+                        k1 = (k1 + m1) % m1;
+                    }
+                    if (k2 < 0 || k2 >= m2) {
+                        if (!d->periodic[a2]) continue;
+                        k2 = (k2 + m2) % m2;
+                    }
+                    for (int k = head[(long)k2 * m1 + k1]; k >= 0 && ok; k = next[k]) {
+                        double e1 = p1 - c1[k], e2 = p2 - c2[k];
+                        if (d->periodic[a1]) e1 -= L1 * round(e1 / L1);
+                        if (d->periodic[a2]) e2 -= L2 * round(e2 / L2);
+                        const double rr = r + cr[k];
+                        if (e1 * e1 + e2 * e2 < rr * rr) ok = 0;
+                    }
+                }
             if (!ok) continue;
             if (nb == maxcap) {
                 maxcap *= 2;
                 c1 = realloc(c1, maxcap * sizeof(double));
                 c2 = realloc(c2, maxcap * sizeof(double));
                 cr = realloc(cr, maxcap * sizeof(double));
+                next = realloc(next, maxcap * sizeof(int));
             }
             c1[nb] = p1;
             c2[nb] = p2;
             cr[nb] = r;
+            next[nb] = head[(long)q2 * m1 + q1];
+            head[(long)q2 * m1 + q1] = nb;
             nb++;
             covered += M_PI * r * r;
             placed = 1;
@@ -285,6 +316,8 @@ void dem_config_bed(dem_t *d, cfg_t *cfg)
     free(c1);
     free(c2);
     free(cr);
+    free(head);
+    free(next);
     msg("dem: random bed of %d fixed grains (coverage %.3f) at %c = %g m\n", nb, covered / area, "xyz"[ax], pos);
 }
 
@@ -309,8 +342,7 @@ void dem_freeze_below(dem_t *d, cfg_t *cfg)
 /* One particle of source = list: "center X Y Z diameter D density RHO ...". */
 static void config_list_particle(dem_t *d, cfg_t *cfg, const char *key)
 {
-    char buf[1024];
-    snprintf(buf, sizeof buf, "%s", cfg_string(cfg, "particles", key));
+    char *buf = strdup(cfg_string(cfg, "particles", key));
     double x[3] = {0, 0, 0}, v[3] = {0, 0, 0}, w[3] = {0, 0, 0}, r = -1, rho = cfg_double(cfg, "particles", "density");
     int have_x = 0, fixed = 0;
     char *save = NULL;
@@ -324,12 +356,11 @@ static void config_list_particle(dem_t *d, cfg_t *cfg, const char *key)
         else if (!strcmp(tok, "velocity")) nv = 3, dst = v;
         else if (!strcmp(tok, "omega")) nv = 3, dst = w;
         else if (!strcmp(tok, "fixed")) fixed = 1;
-        else cfg_fail(cfg, "particles", key, "'%s' is not one of center, radius, diameter, density, velocity, omega, fixed", tok);
+        else cfg_fail(cfg, "particles", key, "'%.40s' is not one of center, radius, diameter, density, velocity, omega, fixed", tok);
         for (int i = 0; i < nv; i++) {
-            char *t = strtok_r(NULL, " \t,", &save), *end;
+            char *t = strtok_r(NULL, " \t,", &save);
             if (!t) cfg_fail(cfg, "particles", key, "%s needs %d number%s", tok, nv, nv > 1 ? "s" : "");
-            dst[i] = strtod(t, &end);
-            if (*end || !isfinite(dst[i])) cfg_fail(cfg, "particles", key, "%s: '%s' is not a number", tok, t);
+            if (!cfg_parse_real(t, &dst[i])) cfg_fail(cfg, "particles", key, "%s: '%.40s' is not a number", tok, t);
         }
         if (diam) r *= 0.5;
     }
@@ -342,11 +373,15 @@ static void config_list_particle(dem_t *d, cfg_t *cfg, const char *key)
                      x[2], r);
     const int i = dem_add_particle(d, x, v, r, rho, fixed);
     dem_set_omega(d, d->id[i], w);
+    free(buf);
 }
 
 void dem_config_particles(dem_t *d, cfg_t *cfg)
 {
     const int source = cfg_enum(cfg, "particles", "source");
+    dem_origin_mark(d, "particles", source == 2 || source == 3 ? "file"
+                                : source == 1 && cfg_has(cfg, "particles", "region_lo") ? "region_lo"
+                                                                                         : "source");
     if (source == 1) {
         double lo[3], hi[3], v0[3];
         for (int a = 0; a < 3; a++) {
@@ -361,6 +396,21 @@ void dem_config_particles(dem_t *d, cfg_t *cfg)
         const long count = cfg_int(cfg, "particles", "count");
         const double phi = cfg_double(cfg, "particles", "volume_fraction");
         if ((count > 0) == (phi > 0)) cfg_fail(cfg, "particles", "count", "give either count or volume_fraction");
+        /* what cannot be: more particles than the region holds at random close
+         * packing (0.64), or than the memory holds (the particle arrays alone
+         * take about 280 bytes a particle) */
+        const double rad = cfg_double(cfg, "particles", "radius"), poly = cfg_double(cfg, "particles", "polydispersity");
+        const char *nkey = phi > 0 ? "volume_fraction" : "count";
+        double vol = 1;
+        for (int a = 0; a < 3; a++) vol *= fmin(hi[a], d->hi[a]) - fmax(lo[a], d->lo[a]);
+        const double expect = count > 0 ? (double)count : phi * vol / dem_sphere_volume(rad);
+        if (count > 0 && count * dem_sphere_volume(rad * (1 - poly)) > 0.64 * fmax(vol, 0.0))
+            cfg_fail(cfg, "particles", nkey, "%ld particles of radius %g m do not fit in the region (volume %g m^3)",
+                     count, rad, fmax(vol, 0.0));
+        const double most = count > 0 ? (double)count : phi * vol / dem_sphere_volume(rad * (1 - poly));
+        if (expect * 280.0 + most * 8.0 > physical_memory_bytes())
+            cfg_fail(cfg, "particles", nkey, "about %.3g particles need more than the %.3g GB of memory of this machine",
+                     expect, physical_memory_bytes() / 1e9);
         const char *why = NULL;
         const int n0 = d->n;
         if (dem_insert_random(d, lo, hi, count, phi, cfg_double(cfg, "particles", "radius"),
@@ -370,16 +420,27 @@ void dem_config_particles(dem_t *d, cfg_t *cfg)
             cfg_fail(cfg, "particles", phi > 0 ? "volume_fraction" : "count", "%s", why);
         msg("dem: inserted %d particles at random\n", d->n - n0);
     } else if (source == 2) {
-        dem_read_checkpoint(d, cfg_string(cfg, "particles", "file"));
+        const char *path = cfg_string(cfg, "particles", "file");
+        long np;
+        hid_t f = io_h5_open_packing(cfg, "particles", "file", path, &np);
+        static const char *need[] = {"velocity", "omega", "density", "id", "fixed"};
+        for (int k = 0; k < 5; k++)
+            if (H5Lexists(f, need[k], H5P_DEFAULT) <= 0)
+                cfg_fail(cfg, "particles", "file", "%s: no dataset %s (a DEM packing or checkpoint has position, "
+                         "velocity, omega, radius, density, id, fixed)", path, need[k]);
+        if (H5Aexists(f, "time") <= 0) cfg_fail(cfg, "particles", "file", "%s: no attribute time", path);
+        H5Fclose(f);
+        dem_read_checkpoint(d, path);
     } else if (source == 3) {
         double blo[3], bhi[3];
-        dem_read_lammps_data(d, cfg_string(cfg, "particles", "file"), blo, bhi, 0);
+        dem_read_lammps_data(d, cfg, cfg_string(cfg, "particles", "file"), blo, bhi, 0);
     } else if (source == 4) {
         int count = 0;
         for (int k = 1; k <= 9; k++) {
             char key[24];
             snprintf(key, sizeof key, "particle%d", k);
             if (!cfg_has(cfg, "particles", key)) continue;
+            dem_origin_mark(d, "particles", key);
             config_list_particle(d, cfg, key);
             count++;
         }
@@ -571,7 +632,7 @@ dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
     if (source == 3 && !cfg_has(cfg, "domain", "length")) {
         /* the box of the LAMMPS data file */
         double blo[3], bhi[3];
-        dem_read_lammps_data(d, cfg_string(cfg, "particles", "file"), blo, bhi, 1);
+        dem_read_lammps_data(d, cfg, cfg_string(cfg, "particles", "file"), blo, bhi, 1);
         for (int a = 0; a < 3; a++) {
             o[a] = blo[a];
             L[a] = bhi[a] - blo[a];
@@ -628,8 +689,11 @@ dem_t *dem_create_from_config(cfg_t *cfg, MPI_Comm comm)
     const int src = cfg_enum(cfg, "particles", "source");
     if (src == 2 && cfg_enum(cfg, "bed", "type") != 0)
         cfg_fail(cfg, "bed", "type", "must be none when the particles come from a packing file (it holds the bed)");
+    dem_origin_reset();
+    dem_origin_mark(d, "bed", "type");
     dem_config_bed(d, cfg);
     dem_config_particles(d, cfg);
+    dem_check_geometry(d, cfg);
     /* a time step too large for the contact time: stop now when it is known */
     if (d->dt_user > 0) {
         const double tc = d->law->contact_time(d);

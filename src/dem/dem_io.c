@@ -32,14 +32,32 @@ static hid_t open_file(const dem_t *d, const char *path, int create)
     return f;
 }
 
+/* Close a file written: flushed to the disk first (MPI_File_sync); a failure
+ * is an I/O error (util.h). */
+static void close_written(hid_t f, const char *path)
+{
+    const int flush_failed = H5Fflush(f, H5F_SCOPE_GLOBAL) < 0;
+    const int close_failed = H5Fclose(f) < 0;
+    if (close_failed) mpi_finalize_unsafe(); /* the file is left half closed (HDF5 1.10) */
+    if (close_failed || flush_failed) io_error_collective("cannot write the HDF5 file %s (HDF5 error, see above)", path);
+}
+
+/* A dataset or attribute not written: an I/O error naming its file. */
+static void write_failed(hid_t loc, const char *name)
+{
+    char file[4096] = "?";
+    H5Fget_name(loc, file, sizeof file);
+    io_error_collective("cannot write %s in the HDF5 file %s (HDF5 error, see above)", name, file);
+}
+
 /* Collective creation, rank-0 write of an n×comp dataset. */
 static void write_ds(const dem_t *d, hid_t file, const char *name, hid_t type, const void *data, long n, int comp)
 {
     hsize_t dims[2] = {(hsize_t)n, (hsize_t)comp};
     hid_t sp = H5Screate_simple(comp > 1 ? 2 : 1, dims, NULL);
     hid_t ds = H5Dcreate2(file, name, type, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    if (ds < 0) die("dem: cannot create dataset %s", name);
-    if (d->rank == 0 && n > 0) H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data);
+    if (ds < 0 || (d->rank == 0 && n > 0 && H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0))
+        write_failed(file, name);
     H5Dclose(ds);
     H5Sclose(sp);
 }
@@ -49,7 +67,7 @@ static void write_attr_d(hid_t obj, const char *name, const double *v, int n)
     hsize_t dims = (hsize_t)n;
     hid_t sp = H5Screate_simple(1, &dims, NULL);
     hid_t a = H5Acreate2(obj, name, H5T_NATIVE_DOUBLE, sp, H5P_DEFAULT, H5P_DEFAULT);
-    H5Awrite(a, H5T_NATIVE_DOUBLE, v);
+    if (a < 0 || H5Awrite(a, H5T_NATIVE_DOUBLE, v) < 0) write_failed(obj, name);
     H5Aclose(a);
     H5Sclose(sp);
 }
@@ -58,7 +76,7 @@ static void write_attr_l(hid_t obj, const char *name, long v)
 {
     hid_t sp = H5Screate(H5S_SCALAR);
     hid_t a = H5Acreate2(obj, name, H5T_NATIVE_LONG, sp, H5P_DEFAULT, H5P_DEFAULT);
-    H5Awrite(a, H5T_NATIVE_LONG, &v);
+    if (a < 0 || H5Awrite(a, H5T_NATIVE_LONG, &v) < 0) write_failed(obj, name);
     H5Aclose(a);
     H5Sclose(sp);
 }
@@ -172,10 +190,10 @@ static void snap_record(dem_t *d, int index, double t, long n)
 static void write_xdmf(dem_t *d, const char *dir)
 {
     if (d->rank != 0) return;
-    char path[4096];
+    char path[4096], tmp[4112];
     snprintf(path, sizeof path, "%s/particles.xdmf", dir);
-    FILE *fp = fopen(path, "w");
-    if (!fp) die_local("cannot write %s", path);
+    FILE *fp = atomic_open(path, tmp, sizeof tmp);
+    if (!fp) return;
     fprintf(fp, "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"3.0\">\n<Domain>\n"
                 "<Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
     for (int s = 0; s < d->nsnap; s++) {
@@ -204,7 +222,7 @@ static void write_xdmf(dem_t *d, const char *dir)
                 n, base, n, base, n, base);
     }
     fprintf(fp, "</Grid>\n</Domain>\n</Xdmf>\n");
-    fclose(fp);
+    atomic_commit(fp, tmp, path);
 }
 
 void dem_snapshots_resume(dem_t *d, const char *dir, int first)
@@ -220,6 +238,7 @@ void dem_snapshots_resume(dem_t *d, const char *dir, int first)
         H5Fclose(f);
         snap_record(d, k, t, n);
     }
+    write_xdmf(d, dir); /* the index of these only */
 }
 
 void dem_write_snapshot(dem_t *d, const char *dir, int index)
@@ -231,7 +250,7 @@ void dem_write_snapshot(dem_t *d, const char *dir, int index)
     write_attr_d(f, "time", &d->time, 1);
     write_attr_l(f, "step", d->step);
     write_particles(d, f, 0);
-    H5Fclose(f);
+    close_written(f, path);
     snap_record(d, index, d->time, d->n);
     write_xdmf(d, dir);
 }
@@ -240,7 +259,7 @@ void dem_write_checkpoint(dem_t *d, const char *path)
 {
     hid_t f = open_file(d, path, 1);
     dem_checkpoint_write_loc(d, f);
-    H5Fclose(f);
+    close_written(f, path);
 }
 
 void dem_checkpoint_write_loc(dem_t *d, hid_t f)
@@ -597,17 +616,40 @@ forces:
 
 /* ---- LAMMPS data files ---- */
 
-void dem_read_lammps_data(dem_t *d, const char *path, double box_lo[3], double box_hi[3], int read_box)
+/* Numbers of a data line: up to max decimal numbers (cfg_parse_real),
+ * blank-separated; returns how many, -1 if a word is not a number. */
+static int data_numbers(char *line, double *v, int max)
+{
+    int k = 0;
+    char *save = NULL;
+    for (char *tok = strtok_r(line, " \t\r\n", &save); tok; tok = strtok_r(NULL, " \t\r\n", &save)) {
+        if (k == max || !cfg_parse_real(tok, &v[k])) return -1;
+        k++;
+    }
+    return k;
+}
+
+/* A bad data file: an input error of particles.file (cfg), else fatal. */
+#define DATA_FAIL(cfg, ...)                                                                                      \
+    do {                                                                                                         \
+        if (cfg) cfg_fail(cfg, "particles", "file", __VA_ARGS__);                                                \
+        die(__VA_ARGS__);                                                                                        \
+    } while (0)
+
+void dem_read_lammps_data(dem_t *d, cfg_t *cfg, const char *path, double box_lo[3], double box_hi[3], int read_box)
 {
     FILE *fp = fopen(path, "r");
-    if (!fp) die("dem: cannot open LAMMPS data file %s", path);
-    char line[1024];
-    long natoms = -1;
+    if (!fp) DATA_FAIL(cfg, "cannot open the LAMMPS data file %s", path);
+    char *line = NULL;
+    size_t cap = 0;
+    long natoms = -1, lineno = 1;
     int section = 0; /* 1 Atoms, 2 Velocities */
-    double *x = NULL, *v = NULL, *dia = NULL, *rho = NULL;
+    double *x = NULL, *v = NULL, *w = NULL, *dia = NULL, *rho = NULL;
     long seen = 0;
-    if (!fgets(line, sizeof line, fp)) die("dem: %s is empty", path); /* title line */
-    while (fgets(line, sizeof line, fp)) {
+    int have_box[3] = {0, 0, 0};
+    if (getline(&line, &cap, fp) < 0) DATA_FAIL(cfg, "%s is empty", path); /* title line */
+    while (getline(&line, &cap, fp) > 0) {
+        lineno++;
         char *hash = strchr(line, '#');
         if (hash) *hash = 0;
         char w1[64] = "";
@@ -615,80 +657,79 @@ void dem_read_lammps_data(dem_t *d, const char *path, double box_lo[3], double b
         if (!strcmp(w1, "Atoms")) {
             section = 1;
             if (read_box) break;
-            if (natoms <= 0) die("dem: %s: Atoms before the atom count", path);
-            x = calloc(3 * (size_t)natoms, sizeof(double));
-            v = calloc(3 * (size_t)natoms, sizeof(double));
-            dia = calloc((size_t)natoms, sizeof(double));
-            rho = calloc((size_t)natoms, sizeof(double));
+            if (natoms <= 0) DATA_FAIL(cfg, "%s:%ld: Atoms before the atom count", path, lineno);
+            x = xcalloc(3 * (size_t)natoms, sizeof(double));
+            v = xcalloc(3 * (size_t)natoms, sizeof(double));
+            w = xcalloc(3 * (size_t)natoms, sizeof(double));
+            dia = xcalloc((size_t)natoms, sizeof(double));
+            rho = xcalloc((size_t)natoms, sizeof(double));
             continue;
         }
         if (!strcmp(w1, "Velocities")) {
+            if (section != 1) DATA_FAIL(cfg, "%s:%ld: Velocities before Atoms", path, lineno);
             section = 2;
             continue;
         }
         if (section == 0) {
             double a, b;
-            char s1[32], s2[32];
-            if (strstr(line, "atoms") && !strstr(line, "types") && sscanf(line, "%ld", &natoms) == 1) continue;
-            if (sscanf(line, "%lf %lf %31s %31s", &a, &b, s1, s2) == 4) {
+            char s1[32], s2[32], n1[64], n2[64];
+            if (strstr(line, "atoms") && !strstr(line, "types")) {
+                double nat;
+                if (sscanf(line, "%63s", n1) != 1 || !cfg_parse_real(n1, &nat) || !(nat >= 1 && nat <= 2e9) ||
+                    nat != floor(nat))
+                    DATA_FAIL(cfg, "%s:%ld: bad atom count", path, lineno);
+                natoms = (long)nat;
+                continue;
+            }
+            if (sscanf(line, "%63s %63s %31s %31s", n1, n2, s1, s2) == 4) {
                 const int ax = !strcmp(s1, "xlo") ? 0 : !strcmp(s1, "ylo") ? 1 : !strcmp(s1, "zlo") ? 2 : -1;
                 if (ax >= 0) {
+                    if (!cfg_parse_real(n1, &a) || !cfg_parse_real(n2, &b) || !(b > a))
+                        DATA_FAIL(cfg, "%s:%ld: bad box bounds", path, lineno);
                     box_lo[ax] = a;
                     box_hi[ax] = b;
+                    have_box[ax] = 1;
                 }
             }
             continue;
         }
-        long id;
+        double a[10];
+        const int k = data_numbers(line, a, 10);
+        if (section == 1 ? k != 7 && k != 10 : k != 7 && k != 4)
+            DATA_FAIL(cfg, "%s:%ld: a %s line needs %s numbers", path, lineno, section == 1 ? "Atoms" : "Velocities",
+                      section == 1 ? "7 (id type diameter density x y z [ix iy iz])" : "4 or 7 (id vx vy vz [wx wy wz])");
+        if (!(a[0] >= 1 && a[0] <= natoms && a[0] == floor(a[0])))
+            DATA_FAIL(cfg, "%s:%ld: atom id %g out of range", path, lineno, a[0]);
+        const long id = (long)a[0] - 1;
         if (section == 1) {
-            int type;
-            double di, de, px, py, pz;
-            if (sscanf(line, "%ld %d %lf %lf %lf %lf %lf", &id, &type, &di, &de, &px, &py, &pz) != 7)
-                die("dem: %s: bad Atoms line: %s", path, line);
-            if (id < 1 || id > natoms) die("dem: %s: atom id %ld out of range", path, id);
-            const long k = id - 1;
-            x[3 * k] = px;
-            x[3 * k + 1] = py;
-            x[3 * k + 2] = pz;
-            dia[k] = di;
-            rho[k] = de;
+            for (int c = 0; c < 3; c++) x[3 * id + c] = a[4 + c];
+            dia[id] = a[2];
+            rho[id] = a[3];
+            if (!(dia[id] > 0) || !(rho[id] > 0))
+                DATA_FAIL(cfg, "%s:%ld: the diameter and density must be positive", path, lineno);
             seen++;
         } else {
-            double a[6];
-            if (sscanf(line, "%ld %lf %lf %lf %lf %lf %lf", &id, a, a + 1, a + 2, a + 3, a + 4, a + 5) < 4)
-                die("dem: %s: bad Velocities line: %s", path, line);
-            if (id < 1 || id > natoms) die("dem: %s: atom id %ld out of range", path, id);
-            for (int c = 0; c < 3; c++) v[3 * (id - 1) + c] = a[c];
+            for (int c = 0; c < 3; c++) {
+                v[3 * id + c] = a[1 + c];
+                w[3 * id + c] = k == 7 ? a[4 + c] : 0.0;
+            }
         }
     }
     fclose(fp);
-    if (read_box) return;
-    if (seen != natoms) die("dem: %s: %ld atoms declared, %ld read", path, natoms, seen);
+    free(line);
+    if (read_box) {
+        if (!have_box[0] || !have_box[1] || !have_box[2])
+            DATA_FAIL(cfg, "%s: the box (xlo xhi, ylo yhi, zlo zhi) is missing", path);
+        return;
+    }
+    if (natoms <= 0 || seen != natoms) DATA_FAIL(cfg, "%s: %ld atoms declared, %ld read", path, natoms, seen);
     const int n0 = d->n;
     for (long k = 0; k < natoms; k++) dem_add_particle(d, &x[3 * k], &v[3 * k], 0.5 * dia[k], rho[k], 0);
-    /* angular velocities are in the Velocities section too: re-read them */
-    fp = fopen(path, "r");
-    section = 0;
-    while (fgets(line, sizeof line, fp)) {
-        char w1[64] = "";
-        if (sscanf(line, "%63s", w1) != 1) continue;
-        if (!strcmp(w1, "Velocities")) {
-            section = 2;
-            continue;
-        }
-        if (!strcmp(w1, "Atoms")) {
-            section = 1;
-            continue;
-        }
-        if (section != 2) continue;
-        long id;
-        double a[6];
-        if (sscanf(line, "%ld %lf %lf %lf %lf %lf %lf", &id, a, a + 1, a + 2, a + 3, a + 4, a + 5) == 7)
-            for (int c = 0; c < 3; c++) d->w[3 * (n0 + id - 1) + c] = a[3 + c];
-    }
-    fclose(fp);
+    for (long k = 0; k < natoms; k++)
+        for (int c = 0; c < 3; c++) d->w[3 * (n0 + k) + c] = w[3 * k + c];
     free(x);
     free(v);
+    free(w);
     free(dia);
     free(rho);
     msg("dem: read %ld particles from %s\n", natoms, path);
@@ -698,8 +739,9 @@ void dem_write_lammps_data(dem_t *d, const char *path)
 {
     dem_sync_velocities(d);
     if (d->rank != 0) return;
-    FILE *fp = fopen(path, "w");
-    if (!fp) die_local("cannot write %s", path);
+    char tmp[4112];
+    FILE *fp = atomic_open(path, tmp, sizeof tmp);
+    if (!fp) die_local("%s", io_error_message());
     int *o = id_order(d);
     fprintf(fp, "ibmdem DEM state at t = %.10g s\n\n%d atoms\n1 atom types\n\n", d->time, d->n);
     const char *ax = "xyz";
@@ -716,6 +758,6 @@ void dem_write_lammps_data(dem_t *d, const char *path)
         fprintf(fp, "%d %.6e %.6e %.6e %.6e %.6e %.6e\n", k + 1, d->v[3 * i], d->v[3 * i + 1], d->v[3 * i + 2],
                 d->w[3 * i], d->w[3 * i + 1], d->w[3 * i + 2]);
     }
-    fclose(fp);
     free(o);
+    if (atomic_commit(fp, tmp, path)) die_local("%s", io_error_message());
 }

@@ -245,12 +245,20 @@ void dem_compute_forces(dem_t *d);
 void dem_sync_velocities(dem_t *d);
 double dem_elastic_energy(const dem_t *d);
 void dem_config_particles(dem_t *d, cfg_t *cfg);
+/* The particles added from now on come from section.key (dem_check.c);
+ * reset before a scene is built. */
+void dem_origin_reset(void);
+void dem_origin_mark(const dem_t *d, const char *section, const char *key);
+/* Stop with file:line: section.key: reason on a starting geometry that cannot be (dem_check.c). */
+void dem_check_geometry(dem_t *d, cfg_t *cfg);
 void dem_config_bed(dem_t *d, cfg_t *cfg);
 void dem_freeze_below(dem_t *d, cfg_t *cfg);
 int dem_insert_random(dem_t *d, const double lo[3], const double hi[3], long count, double phi, double rmean,
                       double poly, double rho, const double v0[3], double vspread, unsigned long seed,
                       const char **why);
-void dem_read_lammps_data(dem_t *d, const char *path, double box_lo[3], double box_hi[3], int read_box);
+/* Read a LAMMPS data file; a bad file is an input error of particles.file
+ * (cfg), or fatal with cfg = NULL. */
+void dem_read_lammps_data(dem_t *d, cfg_t *cfg, const char *path, double box_lo[3], double box_hi[3], int read_box);
 void dem_add_wall(dem_t *d, const char *name, const double p[3], const double n[3], const double vel[3],
                   double remove_time);
 

@@ -1,4 +1,5 @@
 /* dem_run.c — packing preparation and the DEM-only run of a case file. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -134,8 +135,7 @@ static void series_line(dem_t *d, FILE *fp)
             g.e_elastic, g.n_contacts, g.n_wall_contacts, g.max_overlap, g.com[0], g.com[1], g.com[2]);
     for (int w = 0; w < d->nwall; w++)
         fprintf(fp, ",%.10g,%.10g,%.10g", d->wall[w].force[0], d->wall[w].force[1], d->wall[w].force[2]);
-    fprintf(fp, "\n");
-    fflush(fp);
+    if (fprintf(fp, "\n") < 0 || fflush(fp) != 0) io_error("cannot write dem_series.csv: %s", strerror(errno));
 }
 
 int dem_run_case(cfg_t *cfg, const char *outdir)
@@ -151,11 +151,12 @@ int dem_run_case(cfg_t *cfg, const char *outdir)
     if (d->n == 0) die("dem: the scene has no particles");
     char path[4096];
     if (mpi_rank() == 0) {
+        char tmp[4112];
         snprintf(path, sizeof path, "%s/resolved.ini", outdir);
-        FILE *fp = fopen(path, "w");
+        FILE *fp = atomic_open(path, tmp, sizeof tmp);
         if (fp) {
             cfg_write_resolved(cfg, fp);
-            fclose(fp);
+            atomic_commit(fp, tmp, path);
         }
     }
     int rc = dem_prepare_packing(d, cfg, outdir);
@@ -216,15 +217,16 @@ int dem_run_case(cfg_t *cfg, const char *outdir)
     dem_write_snapshot(d, outdir, snap++);
     snprintf(path, sizeof path, "%s/dem_final.h5", outdir);
     dem_write_checkpoint(d, path);
-    if (ser) fclose(ser);
+    if (ser && fclose(ser) != 0) io_error("cannot write %s/dem_series.csv: %s", outdir, strerror(errno));
     const double pps = wall > 0 ? (double)d->n * steps / wall : 0;
     msg("dem: %ld steps in %.2f s: %.3g particle-steps/s (pairs %.2f s, walls %.2f s, lists %.2f s, integration "
         "%.2f s, communication %.2f s), %ld list builds, %.0f bytes/particle\n",
         steps, wall, pps, d->t_pair, d->t_wall, d->t_build, d->t_integ, d->t_comm, d->rebuilds,
         dem_memory_per_particle(d));
     if (mpi_rank() == 0) {
+        char tmp[4112];
         snprintf(path, sizeof path, "%s/dem_summary.json", outdir);
-        FILE *fp = fopen(path, "w");
+        FILE *fp = atomic_open(path, tmp, sizeof tmp);
         if (fp) {
             dem_diag_t g;
             dem_diag(d, &g);
@@ -235,12 +237,19 @@ int dem_run_case(cfg_t *cfg, const char *outdir)
                     "\"bytes_per_particle\": %.1f,\n  \"ranks\": %d\n}\n",
                     d->n, steps, d->time, d->dt, d->tc, wall, pps, at_rest ? "true" : "false", g.ke_trans,
                     g.n_contacts, g.max_overlap, dem_memory_per_particle(d), d->nranks);
-            fclose(fp);
+            atomic_commit(fp, tmp, path);
         }
     } else {
         dem_diag_t g;
         dem_diag(d, &g);
     }
     dem_free(d);
+    /* a write failed on some rank: the run's outputs are not complete */
+    int bad = io_error_message()[0] != 0;
+    MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (bad) {
+        if (io_error_message()[0]) fprintf(stderr, "error: %s\n", io_error_message());
+        return 1;
+    }
     return 0;
 }

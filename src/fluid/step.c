@@ -11,6 +11,10 @@
  *   hooks of a particle module (the immersed boundary): stage begin before
  *   the predictor; the plane hook on each plane of u* (inside the predictor
  *   sweep where it can be); the stage hook on u*
+ *   [Crank–Nicolson with FLUID_HOOK_PREDICTOR: the plane hook on the
+ *    right-hand side before the solve, forming the explicit predictor
+ *    ũ = rhs + α_k Δt ν/2 L u^{k−1} (the whole viscous term explicit) at its
+ *    nodes; the solve's right-hand side is then rhs + the forcing]
  *   L φ   = D u* / (α_k Δt),   u^k = u* − α_k Δt G φ,
  *   p^k   = p^{k−1} + φ  [− α_k Δt ν/2 L φ when Crank–Nicolson],
  *   stage-end hook (immersed boundary: particle update) on u^k.
@@ -355,7 +359,7 @@ void fluid_step(fluid_t *f, double dt)
      *   done inside the next predictor sweep, when nothing reads u^k in
      *   between (no stage-end hook, or one that promised not to) and the
      *   sweep is the fused one. */
-    int fuse_plane = 0, fuse_div = 0, defer = 0, fwd_planes = 0;
+    int fuse_plane = 0, fuse_div = 0, defer = 0, fwd_planes = 0, pred = 0;
     deferred_correction_t dc = {.f = f};
     fluid_ahead_t ahead = {deferred_ahead, &dc};
     plane_hook_call_t phc = {.f = f};
@@ -369,7 +373,9 @@ void fluid_step(fluid_t *f, double dt)
         if (f->stage_begin_hook) f->stage_begin_hook(f, s, adt, f->hook_ctx);
         if (s == 0) {
             int keeps = !f->stage_hook || (f->hook_flags & FLUID_HOOK_KEEPS_USTAR);
-            fuse_plane = f->plane_hook && is3d && !impl && !q->wq_any;
+            /* Crank–Nicolson with the forcing on the explicit predictor */
+            pred = impl && f->plane_hook && (f->hook_flags & FLUID_HOOK_PREDICTOR);
+            fuse_plane = f->plane_hook && is3d && (!impl || pred) && !q->wq_any;
             fuse_div = is3d && !impl && keeps && (!f->plane_hook || fuse_plane);
             defer = fuse_div && (!f->stage_end_hook || (f->hook_flags & FLUID_HOOK_IDLE_UK));
             /* forward transforms in the sweep (step 1.1c) when D u* is
@@ -390,6 +396,9 @@ void fluid_step(fluid_t *f, double dt)
         phc.adt = adt;
         fpc.us = q->h;
         fpc.scale = 1.0 / adt;
+        /* the forcing on the explicit predictor: u^{k−1} is f->u during the sweep */
+        f->pred_a = pred ? 0.5 * adt * f->prm.nu : 0.0;
+        for (int c = 0; c < nc; c++) f->pred_u[c] = pred ? f->u[c] : NULL;
         fluid_rhs_predict_div(f, -1.0, impl ? 0.0 : f->prm.nu, dt * fluid_rk_gamma[s], dt * fluid_rk_zeta[s], adt,
                               impl ? 0.5 * adt * f->prm.nu : 0.0, s < 2 ? q->spare : NULL, q->h, 1.0 / adt,
                               fuse_div ? q->work : NULL, pending ? &ahead : NULL, fuse_plane ? &done : NULL,
@@ -401,9 +410,16 @@ void fluid_step(fluid_t *f, double dt)
             q->h[c] = q->spare[c];
             q->spare[c] = old;
         }
+        if (pred && !fuse_plane) {
+            /* the forcing of the right-hand side before the solve (u^{k−1}, now
+             * in spare, has valid ghosts) */
+            for (int c = 0; c < nc; c++) f->pred_u[c] = q->spare[c];
+            for (int i = 0; i < g->nxl; i++) f->plane_hook(f, f->u, s, adt, i, f->hook_ctx);
+        }
+        f->pred_a = 0.0;
         if (impl)
             for (int c = 0; c < nc; c++) helmholtz_component(f, c, adt, q->spare[c] /* u^{k−1} */);
-        if (f->plane_hook && !fuse_plane)
+        if (f->plane_hook && !fuse_plane && !pred)
             for (int i = 0; i < g->nxl; i++) f->plane_hook(f, f->u, s, adt, i, f->hook_ctx);
         fluid_apply_bc(f);
         if (fuse_div) fluid_divergence_rest(f, 1.0 / adt, q->work, fwd_planes);

@@ -186,6 +186,31 @@ void fluid_wall_ghost_add(const fluid_t *f, int c, const double *u, double scale
         }
 }
 
+double fluid_laplacian_at(const fluid_t *f, int c, const double *u, int i, long m)
+{
+    const grid_t *g = f->g;
+    const fluid_priv_t *q = fluid_priv(f);
+    const poisson_t *p = q->pv[c];
+    const int ig = i + g->ix0, nx = g->n[0];
+    const long sx = g->sx, sy = g->sy;
+    const double uc = u[m];
+    double L = p->cw[ig] * u[m - sx] + p->ce[ig] * u[m + sx] - p->cd[ig] * uc + p->cy * (u[m + sy] - 2.0 * uc + u[m - sy]);
+    if (g->dim == 3) L += p->cz * (u[m + 1] - 2.0 * uc + u[m - 1]);
+    L += (ig == 0 ? q->xwall[c][0] : 0.0) + (ig == nx - 1 ? q->xwall[c][1] : 0.0);
+    if (!q->wq_any) return L;
+    /* the quadratic wall ghost at a wall cell (fluid_wall_ghost_add) */
+    const long rem = m - (long)(i + 1) * sx;
+    const int idx[3] = {ig, (int)(rem / sy) - 1, (int)(rem % sy) - g->gz};
+    const long step[3] = {sx, sy, 1};
+    for (int d = 0; d < g->dim; d++)
+        for (int s = 0; s < 2; s++) {
+            const wall_quad_t *w = &q->wq[c][d][s];
+            if (!w->on || idx[d] != (s == 0 ? 0 : g->n[d] - 1)) continue;
+            L += w->kU + w->k0 * uc + w->k1 * u[m + (s == 0 ? step[d] : -step[d])];
+        }
+    return L;
+}
+
 void fluid_viscous(const fluid_t *f, double *const out[3])
 {
     const grid_t *g = f->g;

@@ -94,6 +94,20 @@ grid_t *grid_create_from_config(cfg_t *cfg, MPI_Comm comm)
         cfg_fail(cfg, "domain", "nx", "%d cells do not divide among %d ranks (slabs in x)", n[0], nranks);
     if (n[0] / nranks < 2)
         cfg_fail(cfg, "domain", "nx", "%d cells among %d ranks leaves fewer than 2 per rank", n[0], nranks);
+    /* one cell between walls leaves no unknown of the normal velocity */
+    for (int d = 1; d < (geom == GEOM_3D ? 3 : 2); d++)
+        if (n[d] < 2 && bc.type[d][0] != BC_PERIODIC)
+            cfg_fail(cfg, "domain", d == 1 ? "ny" : "nz", "at least 2 cells between walls (got %d)", n[d]);
+    /* a grid no machine of this size holds: the fluid keeps at least 8 fields
+     * of doubles (2-D: u, v, their two Runge-Kutta stores, p and a work
+     * field; 3-D: 11), each of (nx/ranks + 2)(ny + 2)(nz + 2) values a rank */
+    const double bytes = 64.0 * (n[0] / nranks + 2) * (n[1] + 2.0) * (geom == GEOM_3D ? n[2] + 2.0 : 1.0);
+    if (bytes > physical_memory_bytes()) {
+        const int big = n[1] > n[0] && n[1] >= n[2] ? 1 : n[2] > n[0] ? 2 : 0;
+        cfg_fail(cfg, "domain", big == 0 ? "nx" : big == 1 ? "ny" : "nz",
+                 "a grid of %d x %d x %d cells needs at least %.3g GB a rank, more than the %.3g GB of this machine",
+                 n[0], n[1], n[2], bytes / 1e9, physical_memory_bytes() / 1e9);
+    }
     if (st == STRETCH_UNIFORM_ARITHMETIC) {
         const int nu = cfg_int(cfg, "domain", "x_uniform_cells");
         const double lu = cfg_double(cfg, "domain", "x_uniform_length");

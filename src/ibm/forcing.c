@@ -10,7 +10,12 @@
  *  plane hook: inside its sweep, while the plane is in cache, where it can):
  *     u* ← u* + α (U − u*)         at every node with α > 0,
  *  U the rigid-body velocity u_p + ω_p × r of the sphere at the start of the
- *  stage, i.e. f = α (U − u*)/Δt_k.  Overlapping spheres: α = min(1, Σ α_p)
+ *  stage, i.e. f = α (U − u*)/Δt_k (β instead of α with forcing_time).  With
+ *  the Crank–Nicolson viscous term and cn_forcing = predictor the plane hook
+ *  gets the right-hand side of the Helmholtz solve before the solve, and u*
+ *  above is the explicit predictor ũ = rhs + a L u^{k−1} (fluid.h,
+ *  FLUID_HOOK_PREDICTOR): the forcing becomes a source term of the implicit
+ *  solve (docs/theory.md §4.6).  Overlapping spheres: α = min(1, Σ α_p)
  *  and U the α-weighted mean of their velocities; sphere p takes the share
  *  α_p/Σα_p of the node's impulse.  With forcing_iterations = N the pair
  *  (project, force) follows N times (ibm_stage_force, after the sweep).
@@ -138,7 +143,10 @@ static void force_node_runs(ibm_t *ibm, double *const u_of[3], long r0, long r1,
     ibm_priv_t *q = ibm_priv(ibm);
     double kappa = ibm->prm.forcing_time, nu = ibm->f->prm.nu;
     long st = q->rstride;
-    int fast = kappa <= 0 && st == 1;
+    /* the forcing on the explicit predictor (Crank–Nicolson, FLUID_HOOK_PREDICTOR): ũ = u + a L u^{k−1} */
+    const fluid_t *f = ibm->f;
+    const double pa = f->pred_a;
+    int fast = kappa <= 0 && st == 1 && pa == 0.0;
     if (r1 <= r0) return;
     if (first && !fast) {
         long n0 = q->nruns_f[r0].n0, n1 = q->nruns_f[r1 - 1].n0 + q->nruns_f[r1 - 1].len;
@@ -163,6 +171,16 @@ static void force_node_runs(ibm_t *ibm, double *const u_of[3], long r0, long r1,
                     u[k] += imp;
                     J[k] += imp;
                 }
+        } else if (pa != 0.0) {
+            const int i = ibm_node_i(g, nr->m0), c = nr->c;
+            const double *up = f->pred_u[c];
+            double h = q->hcell[c][i], tau = kappa > 0 ? kappa * h * h / nu : 0.0;
+            for (int k = 0; k < len; k++) {
+                const double ut = u[k * st] + pa * fluid_laplacian_at(f, c, up, i, nr->m0 + k * st);
+                double imp = forcing_beta(A[k] < 1.0 ? A[k] : 1.0, dt, tau) * (T[k] - ut);
+                u[k * st] += imp;
+                J[k] += imp;
+            }
         } else if (kappa > 0) {
             double h = q->hcell[nr->c][ibm_node_i(g, nr->m0)], tau = kappa * h * h / nu;
             for (int k = 0; k < len; k++) {
@@ -425,7 +443,7 @@ void ibm_stage_begin(fluid_t *f, int stage, double dt_stage, void *ctx)
         /* the moves made since the last step (ibm_update_geometry) */
         if (q->frozen || ibm->prm.free_alpha_per_step) carry_external_moves(ibm);
         f->hook_flags = (ibm->prm.forcing_iterations == 0 ? FLUID_HOOK_KEEPS_USTAR : 0) |
-                        (q->frozen ? FLUID_HOOK_IDLE_UK : 0);
+                        (q->frozen ? FLUID_HOOK_IDLE_UK : 0) | (ibm->prm.forcing_predictor ? FLUID_HOOK_PREDICTOR : 0);
     }
     double w1 = wtime();
     /* the impulses accumulate over the stages until the targets are set again */

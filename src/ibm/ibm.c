@@ -9,6 +9,7 @@
 
 #include "ibm_internal.h"
 #include "io.h"
+#include "overlap.h"
 #include "util.h"
 
 #define IBM_KEYED_SPHERES 9
@@ -38,6 +39,11 @@ static const cfg_key_t ibm_keys[] = {
      "Runge-Kutta stage (stage), or held where the step started and moved between steps, the fluid momentum "
      "over the jump counted in the next force (step: one rebuild per step instead of three, see "
      "docs/theory.md)"},
+    {"ibm", "cn_forcing", CFG_ENUM, "after_solve", 1, 0, "after_solve|predictor",
+     "with the Crank-Nicolson viscous term ([fluid] viscous = implicit, or auto on its implicit steps): the forcing is computed from the Crank-Nicolson solution and applied "
+     "after the solve (after_solve), or from the explicit predictor with the whole viscous term and applied as a "
+     "source term of the implicit solve (predictor: stable and accurate at large Δt ν/Δx², see docs/theory.md "
+     "§4.6); no effect with the explicit viscous term"},
     {"ibm", "retraction", CFG_DOUBLE, "0", -1, 1, NULL,
      "the solid fraction is that of a sphere of radius R - retraction × Δx (cells): compensates the effective "
      "thickening of the forced sphere (0: the seed's method)"},
@@ -117,8 +123,8 @@ double ibm_stable_dt(const ibm_t *ibm, double cfl)
     double rate = 0.0;
     for (int p = 0; p < ibm->n; p++) {
         const ibm_sphere_t *s = &ibm->s[p];
-        double u = sqrt(s->u[0] * s->u[0] + s->u[1] * s->u[1] + s->u[2] * s->u[2]);
-        double w = sqrt(s->omega[0] * s->omega[0] + s->omega[1] * s->omega[1] + s->omega[2] * s->omega[2]);
+        double u = hypot(hypot(s->u[0], s->u[1]), s->u[2]); /* no overflow of the squares */
+        double w = hypot(hypot(s->omega[0], s->omega[1]), s->omega[2]);
         rate = fmax(rate, (u + w * s->radius) / h);
         if (s->kind == IBM_FREE) {
             /* from rest, the sphere accelerates at most by |g|(1 − ρ/ρp): it
@@ -182,8 +188,11 @@ void ibm_prescribed_velocity(const ibm_t *ibm, const ibm_sphere_t *s, double t, 
 /* Why sphere s does not fit grid g (NULL if it does). */
 static const char *sphere_misfit(const grid_t *g, const ibm_sphere_t *s)
 {
-    if (!(s->radius > 0)) return "the radius must be > 0";
-    if (s->kind == IBM_FREE && !(s->density > 0)) return "a free sphere needs a density > 0";
+    for (int c = 0; c < 3; c++)
+        if (!isfinite(s->x[c]) || !isfinite(s->u[c]) || !isfinite(s->omega[c]))
+            return "a position, velocity or omega that is not a finite number";
+    if (!(s->radius > 0) || !isfinite(s->radius)) return "the radius must be > 0 (and finite)";
+    if (s->kind == IBM_FREE && !(s->density > 0 && isfinite(s->density))) return "a free sphere needs a finite density > 0";
     for (int d = 0; d < g->dim; d++)
         if (!(s->x[d] >= g->x0[d] && s->x[d] <= g->x0[d] + g->L[d])) return "the centre is outside the domain";
     if (g->geom == GEOM_AXI) {
@@ -204,6 +213,8 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
     if (f->stage_begin_hook || f->plane_hook || f->stage_hook || f->stage_end_hook)
         die("immersed boundary: the fluid's stage hooks are already in use");
     if (g->nalloc >= INT32_MAX) die("immersed boundary: a field of %ld values is too large for the node lists", g->nalloc);
+    if (prm->forcing_predictor && prm->forcing_iterations > 0 && f->prm.implicit_viscous)
+        die("immersed boundary: forcing iterations act after the Crank-Nicolson solve, not with the predictor forcing");
     for (int d = 0; d < g->dim; d++)
         if (g->periodic[d] && g->n[d] > 127 * 1000000) die("immersed boundary: grid too large");
     ibm_t *ibm = xcalloc(1, sizeof *ibm);
@@ -305,10 +316,11 @@ static double *read_csv(cfg_t *cfg, const char *key, const char *path, int *nrow
 {
     FILE *fp = fopen(path, "r");
     if (!fp) cfg_fail(cfg, "ibm", key, "cannot open %s", path);
-    char line[4096];
+    char *line = NULL;
+    size_t lcap = 0;
     *ncol = 0;
     /* header (the first line that is not a comment) */
-    while (fgets(line, sizeof line, fp)) {
+    while (getline(&line, &lcap, fp) > 0) {
         if (line[0] == '#' || line[strspn(line, " \t\r\n")] == 0) continue;
         for (char *tok = strtok(line, ", \t\r\n"); tok; tok = strtok(NULL, ", \t\r\n")) {
             if (*ncol == maxcol) cfg_fail(cfg, "ibm", key, "%s: more than %d columns", path, maxcol);
@@ -321,7 +333,7 @@ static double *read_csv(cfg_t *cfg, const char *key, const char *path, int *nrow
     if (*ncol == 0) cfg_fail(cfg, "ibm", key, "%s: no header line", path);
     int cap = 64, n = 0, lineno = 1;
     double *rows = xcalloc((size_t)cap * *ncol, sizeof(double));
-    while (fgets(line, sizeof line, fp)) {
+    while (getline(&line, &lcap, fp) > 0) {
         lineno++;
         if (line[0] == '#' || line[strspn(line, " \t\r\n")] == 0) continue;
         if (n == cap) {
@@ -331,14 +343,13 @@ static double *read_csv(cfg_t *cfg, const char *key, const char *path, int *nrow
         int k = 0;
         for (char *tok = strtok(line, ", \t\r\n"); tok; tok = strtok(NULL, ", \t\r\n"), k++) {
             if (k >= *ncol) cfg_fail(cfg, "ibm", key, "%s:%d: more values than header columns", path, lineno);
-            char *end;
-            double v = strtod(tok, &end);
-            if (*end) {
+            double v;
+            if (!cfg_parse_real(tok, &v)) {
                 /* a kind column may hold a word */
                 if (!strcmp(tok, "free")) v = IBM_FREE;
                 else if (!strcmp(tok, "fixed")) v = IBM_FIXED;
                 else if (!strcmp(tok, "prescribed")) v = IBM_PRESCRIBED;
-                else cfg_fail(cfg, "ibm", key, "%s:%d: '%s' is not a number", path, lineno, tok);
+                else cfg_fail(cfg, "ibm", key, "%s:%d: '%.40s' is not a number", path, lineno, tok);
             }
             rows[(long)n * *ncol + k] = v;
         }
@@ -346,6 +357,7 @@ static double *read_csv(cfg_t *cfg, const char *key, const char *path, int *nrow
         n++;
     }
     fclose(fp);
+    free(line);
     *nrow = n;
     return rows;
 }
@@ -386,10 +398,10 @@ static void spheres_from_csv(cfg_t *cfg, const char *path, double rho_default, i
             t->u[c] = cu[c] >= 0 ? v[cu[c]] : 0.0;
             t->omega[c] = cw[c] >= 0 ? v[cw[c]] : 0.0;
         }
-        t->kind = ck >= 0 ? (ibm_kind_t)(int)v[ck] : (cf >= 0 && v[cf] != 0 ? IBM_FIXED : IBM_FREE);
-        if (t->kind != IBM_FREE && t->kind != IBM_FIXED && t->kind != IBM_PRESCRIBED)
+        if (ck >= 0 && v[ck] != IBM_FREE && v[ck] != IBM_FIXED && v[ck] != IBM_PRESCRIBED)
             cfg_fail(cfg, "ibm", "spheres_file", "%s: row %d: kind must be free (0), fixed (1) or prescribed (2)", path,
                      r + 1);
+        t->kind = ck >= 0 ? (ibm_kind_t)(int)v[ck] : (cf >= 0 && v[cf] != 0 ? IBM_FIXED : IBM_FREE);
     }
     *n += nrow;
     free(rows);
@@ -440,22 +452,21 @@ static void spheres_from_h5(cfg_t *cfg, const char *path, double rho_default, ib
 }
 
 /* Parse "KIND tag values ..." of key sphereN. */
-static void parse_sphere(cfg_t *cfg, const char *key, const char *text, ibm_sphere_t *t, char *history, size_t nh)
+static void parse_sphere(cfg_t *cfg, const char *key, const char *text, ibm_sphere_t *t, char **history)
 {
-    char buf[1024];
-    snprintf(buf, sizeof buf, "%s", text);
+    char *buf = strdup(text);
     for (char *p = buf; *p; p++)
         if (*p == ',') *p = ' ';
     memset(t, 0, sizeof *t);
     t->history = -1;
     t->density = -1;
-    history[0] = 0;
+    *history = NULL;
     char *save = NULL, *tok = strtok_r(buf, " \t", &save);
     if (!tok) cfg_fail(cfg, "ibm", key, "empty");
     if (!strcmp(tok, "free")) t->kind = IBM_FREE;
     else if (!strcmp(tok, "fixed")) t->kind = IBM_FIXED;
     else if (!strcmp(tok, "prescribed")) t->kind = IBM_PRESCRIBED;
-    else cfg_fail(cfg, "ibm", key, "'%s': the first word must be the kind: free, fixed or prescribed", tok);
+    else cfg_fail(cfg, "ibm", key, "'%.40s': the first word must be the kind: free, fixed or prescribed", tok);
     int have_center = 0, have_radius = 0;
     while ((tok = strtok_r(NULL, " \t", &save))) {
         int nv;
@@ -476,19 +487,20 @@ static void parse_sphere(cfg_t *cfg, const char *key, const char *text, ibm_sphe
             char *file = strtok_r(NULL, " \t", &save);
             if (!file) cfg_fail(cfg, "ibm", key, "history needs a file name");
             if (t->kind != IBM_PRESCRIBED) cfg_fail(cfg, "ibm", key, "a velocity history needs the kind prescribed");
-            snprintf(history, nh, "%s", file);
+            free(*history);
+            *history = strdup(file);
             continue;
         } else {
             cfg_fail(cfg, "ibm", key,
-                     "'%s' is not one of center, radius, diameter, density, velocity, omega, history", tok);
+                     "'%.40s' is not one of center, radius, diameter, density, velocity, omega, history", tok);
         }
         for (int i = 0; i < nv; i++) {
-            char *v = strtok_r(NULL, " \t", &save), *end;
+            char *v = strtok_r(NULL, " \t", &save);
             if (!v) cfg_fail(cfg, "ibm", key, "%s needs %d number%s", tok, nv, nv > 1 ? "s" : "");
-            dst[i] = strtod(v, &end);
-            if (*end || !isfinite(dst[i])) cfg_fail(cfg, "ibm", key, "%s: '%s' is not a number", tok, v);
+            if (!cfg_parse_real(v, &dst[i])) cfg_fail(cfg, "ibm", key, "%s: '%.40s' is not a number", tok, v);
         }
     }
+    free(buf);
     if (!have_center) cfg_fail(cfg, "ibm", key, "no center X Y Z");
     if (!have_radius) cfg_fail(cfg, "ibm", key, "no radius (or diameter)");
     if (have_radius == 2) t->radius *= 0.5;
@@ -516,6 +528,83 @@ static double *read_history(cfg_t *cfg, const char *key, const char *path, int *
     return rows;
 }
 
+/* Stop on sphere p with the key that gave it (keynum: see below). */
+#define SPHERE_FAIL(p, ...)                                                                                       \
+    do {                                                                                                          \
+        char key_[24];                                                                                            \
+        snprintf(key_, sizeof key_, "sphere%d", keynum[p]);                                                       \
+        cfg_fail(cfg, keynum[p] < 0 ? "particles" : "ibm", keynum[p] > 0 ? key_ : keynum[p] == 0 ? "spheres_file" \
+                                                                                        : "source",              \
+                 __VA_ARGS__);                                                                                   \
+    } while (0)
+
+/* The spheres must fit the domain (docs/user-guide.md, "What the code
+ * refuses"): smaller than it, with their band within a period, a free sphere
+ * inside the walls and overlapping no other sphere (it would stop the run at
+ * once: the immersed boundary has no contact model), and no sphere inside
+ * another (fixed and prescribed spheres may overlap: their solid fractions
+ * add up; pairs of DEM particles are the DEM's check).  keynum[p]: sphere p
+ * came from [ibm] sphereK (K), spheres_file (0) or is a particle (-1). */
+static void check_spheres(cfg_t *cfg, const grid_t *g, const ibm_sphere_t *s, int n, const int *keynum)
+{
+    const double band = ibm_band_halfwidth();
+    static const char *face[3][2] = {{"x_lo", "x_hi"}, {"y_lo", "y_hi"}, {"z_lo", "z_hi"}};
+    for (int p = 0; p < n; p++) {
+        const double R = s[p].radius;
+        for (int d = 0; d < g->dim; d++) {
+            const double h = d == 0 ? g->gdxf[0] : d == 1 ? g->dy : g->dz;
+            /* along a periodic direction a sphere and its band must fit in the period */
+            if (g->periodic[d] && 2 * (R + (band + 0.5) * h) + h > g->L[d])
+                SPHERE_FAIL(p, "sphere %d (radius %g) and its band of %.2f cells do not fit in the periodic %c length %g: "
+                            "enlarge the domain", p + 1, R, band, "xyz"[d], g->L[d]);
+            if (g->periodic[d]) continue;
+            const int radial = g->geom == GEOM_AXI && d == 0; /* on the axis: its radius against the radial extent */
+            if ((radial ? R : 2 * R) >= g->L[d])
+                SPHERE_FAIL(p, "sphere %d (diameter %g) is larger than the domain in %c (%g)", p + 1, 2 * R, "xyz"[d],
+                            g->L[d]);
+            if (s[p].kind != IBM_FREE) continue;
+            const double out_lo = radial ? 0.0 : g->x0[d] - (s[p].x[d] - R), out_hi = s[p].x[d] + R - (g->x0[d] + g->L[d]);
+            if (out_lo > 0 || out_hi > 0)
+                SPHERE_FAIL(p, "free sphere %d (radius %g, centre %c = %g) crosses the %s face of the domain: a free "
+                            "sphere must start inside the walls", p + 1, R, "xyz"[d], s[p].x[d],
+                            face[d][out_hi > out_lo]);
+        }
+    }
+    overlap_box_t box = {.dim = g->dim};
+    for (int d = 0; d < 3; d++) {
+        box.lo[d] = g->x0[d];
+        box.L[d] = g->L[d];
+        box.periodic[d] = g->periodic[d];
+    }
+    double *x = xcalloc(3 * (size_t)n + 1, sizeof(double)), *r = xcalloc((size_t)n + 1, sizeof(double));
+    unsigned char *act = xcalloc((size_t)n + 1, 1), *isfree = xcalloc((size_t)n + 1, 1);
+    for (int p = 0; p < n; p++) {
+        memcpy(&x[3 * p], s[p].x, 3 * sizeof(double));
+        r[p] = s[p].radius;
+        act[p] = keynum[p] >= 0;
+        isfree[p] = s[p].kind == IBM_FREE;
+    }
+    /* a free sphere touching another would stop the run at once (sim_ibm.c);
+     * other spheres may overlap (one solid), but not lie inside another */
+    int i = 0, j = 0;
+    double delta = 0;
+    const int touch = overlap_find(&box, n, x, r, isfree, 0.0, &i, &j, &delta);
+    const int inside = !touch && overlap_find(&box, n, x, r, act, 1.0 - 1e-9, &i, &j, &delta);
+    free(x);
+    free(r);
+    free(act);
+    free(isfree);
+    const int q = keynum[j] >= 0 ? j : i; /* an [ibm] sphere's key rather than a particle's */
+    if (touch)
+        SPHERE_FAIL(q, "spheres %d and %d (radii %g and %g) overlap by %.3g %% of the smaller diameter, and one is free: "
+                    "immersed spheres have no contact model", i + 1, j + 1, s[i].radius, s[j].radius,
+                    100 * delta / (2 * fmin(s[i].radius, s[j].radius)));
+    if (inside)
+        SPHERE_FAIL(q, "sphere %d (radius %g) lies inside sphere %d (radius %g)", s[i].radius < s[j].radius ? i + 1 : j + 1,
+                    fmin(s[i].radius, s[j].radius), s[i].radius < s[j].radius ? j + 1 : i + 1,
+                    fmax(s[i].radius, s[j].radius));
+}
+
 ibm_t *ibm_create_from_config(cfg_t *cfg, fluid_t *f) { return ibm_create_from_config_with(cfg, f, NULL, 0); }
 
 ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *extra, int nextra)
@@ -536,25 +625,31 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
     if (prm.radius_calibrated && prm.forcing_iterations > 0)
         cfg_fail(cfg, "ibm", "radius_correction", "calibrated needs forcing_iterations = 0 (the calibrated forcing)");
     prm.free_alpha_per_step = cfg_enum(cfg, "ibm", "free_alpha");
+    prm.forcing_predictor = cfg_enum(cfg, "ibm", "cn_forcing") == 1;
+    if (prm.forcing_predictor && prm.forcing_iterations > 0 && f->prm.implicit_viscous)
+        cfg_fail(cfg, "ibm", "forcing_iterations",
+                 "the forcing iterations (project, force) act after the solve: not with cn_forcing = predictor");
     if (g->geom == GEOM_AXI && (prm.gravity[0] != 0.0 || prm.gravity[2] != 0.0))
         cfg_fail(cfg, "ibm", "gravity", "an axisymmetric gravity must be axial (y)");
     if (g->dim == 2 && prm.gravity[2] != 0.0) cfg_fail(cfg, "ibm", "gravity", "a 2-D grid has no z direction");
 
     ibm_sphere_t *s = NULL;
-    int n = 0;
-    char hist[IBM_KEYED_SPHERES][1024];
+    int n = 0, *keynum = NULL; /* the key of each sphere: sphereK (K), spheres_file (0), a particle (-1) */
+    char *hist[IBM_KEYED_SPHERES];
     int hist_of[IBM_KEYED_SPHERES], hist_key[IBM_KEYED_SPHERES], nh = 0;
     for (int k = 1; k <= IBM_KEYED_SPHERES; k++) {
         char key[24];
         snprintf(key, sizeof key, "sphere%d", k);
         if (!cfg_has(cfg, "ibm", key)) continue;
         s = realloc(s, (size_t)(n + 1) * sizeof *s);
-        char h[1024];
-        parse_sphere(cfg, key, cfg_string(cfg, "ibm", key), &s[n], h, sizeof h);
+        keynum = realloc(keynum, (size_t)(n + 1) * sizeof *keynum);
+        keynum[n] = k;
+        char *h;
+        parse_sphere(cfg, key, cfg_string(cfg, "ibm", key), &s[n], &h);
         const char *why = sphere_misfit(g, &s[n]);
         if (why) cfg_fail(cfg, "ibm", key, "%s", why);
-        if (h[0]) {
-            snprintf(hist[nh], sizeof hist[nh], "%s", h);
+        if (h) {
+            hist[nh] = h;
             hist_key[nh] = k;
             hist_of[nh++] = n;
         }
@@ -563,12 +658,14 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
     if (cfg_has(cfg, "ibm", "spheres_file")) {
         const char *path = cfg_string(cfg, "ibm", "spheres_file");
         double rho = cfg_has(cfg, "ibm", "density") ? cfg_double(cfg, "ibm", "density") : -1.0;
-            int n0 = n;
+        int n0 = n;
         if (io_is_h5_path(path))
             spheres_from_h5(cfg, path, rho, &s, &n);
         else
             spheres_from_csv(cfg, path, rho, &s, &n);
+        keynum = realloc(keynum, (size_t)(n + 1) * sizeof *keynum);
         for (int p = n0; p < n; p++) {
+            keynum[p] = 0;
             if (g->dim == 2) s[p].x[2] = 0.0;
             if (s[p].kind == IBM_FREE && !(s[p].density > 0))
                 cfg_fail(cfg, "ibm", cfg_has(cfg, "ibm", "density") ? "density" : "spheres_file",
@@ -580,32 +677,17 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
     }
     if (nextra > 0) {
         s = realloc(s, (size_t)(n + nextra) * sizeof *s);
+        keynum = realloc(keynum, (size_t)(n + nextra) * sizeof *keynum);
         for (int p = 0; p < nextra; p++) {
             s[n + p] = extra[p];
+            keynum[n + p] = -1;
             const char *why = sphere_misfit(g, &s[n + p]);
             if (why) cfg_fail(cfg, "particles", "source", "particle %d as an immersed sphere: %s", p, why);
         }
         n += nextra;
     }
     if (n == 0) cfg_fail(cfg, "ibm", "sphere1", "the [ibm] section defines no sphere (sphere1.. or spheres_file)");
-    /* along a periodic direction a sphere and its band must fit in the period */
-    double band = ibm_band_halfwidth();
-    for (int p = 0; p < n; p++)
-        for (int d = 0; d < g->dim; d++) {
-            double h = d == 0 ? g->gdxf[0] : d == 1 ? g->dy : g->dz;
-            if (g->periodic[d] && 2 * (s[p].radius + (band + 0.5) * h) + h > g->L[d]) {
-                char key[24];
-                int k = 0, seen = 0;
-                for (k = 1; k <= IBM_KEYED_SPHERES; k++) {
-                    snprintf(key, sizeof key, "sphere%d", k);
-                    if (cfg_has(cfg, "ibm", key) && seen++ == p) break;
-                }
-                cfg_fail(cfg, "ibm", k <= IBM_KEYED_SPHERES ? key : "spheres_file",
-                         "sphere %d (radius %g) and its band of %.2f cells do not fit in the periodic %c length %g: "
-                         "enlarge the domain",
-                         p + 1, s[p].radius, band, "xyz"[d], g->L[d]);
-            }
-        }
+    check_spheres(cfg, g, s, n, keynum);
     for (int p = 0; p < n; p++)
         if (prm.force_model == IBM_FORCE_RIGID && s[p].kind == IBM_FREE &&
             fabs(s[p].density - f->prm.rho) < 1e-12 * f->prm.rho)
@@ -617,6 +699,7 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
         char key[24];
         snprintf(key, sizeof key, "sphere%d", hist_key[h]);
         double *rows = read_history(cfg, key, hist[h], &nrow);
+        free(hist[h]);
         ibm_sphere_t *sp = &ibm->s[hist_of[h]];
         sp->history = ibm_add_history(ibm, nrow, rows);
         ibm_prescribed_velocity(ibm, sp, f->time, sp->u, sp->omega);
@@ -624,5 +707,6 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
     }
     if (nh > 0) ibm_update_geometry(ibm);
     free(s);
+    free(keynum);
     return ibm;
 }

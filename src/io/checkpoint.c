@@ -6,7 +6,9 @@
  * run add one group each (the fluid: /fluid with u, v, w, p) — see sim.c.
  * The file is written under a temporary name and renamed when complete. */
 #include <dirent.h>
+#include <errno.h>
 #include <inttypes.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -47,8 +49,9 @@ static int cmp_step(const void *a, const void *b)
 }
 
 /* Delete the oldest checkpoints of dir beyond the `keep` newest. */
-static void prune(const char *dir, int keep)
+void io_checkpoint_prune(const char *dir, int keep)
 {
+    if (keep <= 0 || mpi_rank() != 0) return;
     DIR *d = opendir(dir);
     if (!d) return;
     ckpt_entry_t *list = NULL;
@@ -71,27 +74,38 @@ static void prune(const char *dir, int keep)
     for (int i = 0; i < n - keep; i++) {
         char path[IO_PATH_MAX + 300];
         snprintf(path, sizeof path, "%s/%s", dir, list[i].name);
-        remove(path);
+        if (remove(path) != 0) warn("cannot delete the old checkpoint %s: %s\n", path, strerror(errno));
     }
     free(list);
 }
 
-void io_checkpoint_end(hid_t file, const char *dir, long step, int keep, char *path, size_t npath, MPI_Comm comm)
+int io_checkpoint_end(hid_t file, const char *dir, long step, int keep, char *path, size_t npath, MPI_Comm comm)
 {
-    char tmp[IO_PATH_MAX + 64], final[IO_PATH_MAX + 64];
-    H5Fflush(file, H5F_SCOPE_GLOBAL);
-    io_h5_close(file);
+    char tmp[IO_PATH_MAX + 64], final[IO_PATH_MAX + 64], why[IO_PATH_MAX + 1024] = "";
+    fault_point("checkpoint-data", step); /* killed while the data is being written */
+    io_h5_close(file);                    /* flushed to the disk: MPI_File_sync */
     checkpoint_name(dir, step, ".tmp", tmp, sizeof tmp);
     checkpoint_name(dir, step, "", final, sizeof final);
-    int rank, err = 0;
+    int rank;
     MPI_Comm_rank(comm, &rank);
+    if (io_check_errors(comm, why, sizeof why)) {
+        /* not a checkpoint: the previous one stays the newest */
+        if (rank == 0) remove(tmp);
+        return -1;
+    }
+    fault_point("checkpoint-written", step); /* complete under its temporary name */
+    int err = 0;
     if (rank == 0) {
         err = rename(tmp, final) != 0;
-        if (!err && keep > 0) prune(dir, keep);
+        if (err) io_error("cannot rename %s to %s: %s", tmp, final, strerror(errno));
+        else err = fsync_dir(dir) != 0; /* the new name is durable */
     }
     MPI_Bcast(&err, 1, MPI_INT, 0, comm);
-    if (err) die("cannot rename %s to %s", tmp, final);
+    if (err) return -1;
+    fault_point("checkpoint-renamed", step);
+    io_checkpoint_prune(dir, keep);
     if (path) snprintf(path, npath, "%s", final);
+    return 0;
 }
 
 hid_t io_checkpoint_open(const char *path, io_checkpoint_header_t *h, MPI_Comm comm)
@@ -117,6 +131,12 @@ hid_t io_checkpoint_open(const char *path, io_checkpoint_header_t *h, MPI_Comm c
     h->fingerprint = strtoull(fp, NULL, 16);
     h->nranks = (int)nranks;
     h->input = io_h5_read_text(f, "input");
+    /* a state with a NaN or an infinity in it cannot be continued */
+    char where[512];
+    if (io_h5_check_finite(f, comm, where, sizeof where) || !isfinite(h->time))
+        die("%s: %s holds non-finite values (NaN or infinity): not a state a run can continue from; restart from "
+            "an earlier checkpoint",
+            path, isfinite(h->time) ? where : "the attribute time");
     return f;
 }
 

@@ -181,19 +181,19 @@ static void write_xdmf(const io_snapshots_t *s)
 {
     char path[IO_PATH_MAX + 16], tmp[IO_PATH_MAX + 24];
     snprintf(path, sizeof path, "%s/fields.xmf", s->dir);
-    snprintf(tmp, sizeof tmp, "%s.tmp", path);
-    FILE *f = fopen(tmp, "w");
-    if (!f) {
-        warn("cannot write %s\n", tmp);
-        return;
-    }
+    FILE *f = atomic_open(path, tmp, sizeof tmp);
+    if (!f) return;
     fprintf(f, "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"2.0\">\n"
                "  <Domain>\n  <Grid Name=\"fields\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
     for (int i = 0; i < s->nblock; i++)
         if (s->block[i]) fputs(s->block[i], f);
     fprintf(f, "  </Grid>\n  </Domain>\n</Xdmf>\n");
-    fclose(f);
-    rename(tmp, path);
+    atomic_commit(f, tmp, path);
+}
+
+void io_snapshots_write_index(const io_snapshots_t *s)
+{
+    if (s->g->rank == 0) write_xdmf(s);
 }
 
 void io_snapshot_end(io_snapshots_t *s)

@@ -42,15 +42,21 @@ void io_summary_string(io_summary_t *s, const char *key, const char *v)
     size_t cap = 2 * strlen(v) + 8 * 6 + 3, n = 0;
     char *out = malloc(cap);
     out[n++] = '"';
+    /* JSON is UTF-8: a byte that is not (a file name may hold any) is U+FFFD */
+    const size_t len = strlen(v);
     for (const unsigned char *c = (const unsigned char *)v; *c; c++) {
         if (n + 8 > cap) out = realloc(out, cap *= 2);
+        const size_t u = cfg_utf8_char((const char *)c, len - (size_t)(c - (const unsigned char *)v));
         if (*c == '"' || *c == '\\') {
             out[n++] = '\\';
             out[n++] = (char)*c;
-        } else if (*c < 0x20) {
+        } else if (*c < 0x20 || *c == 0x7F) {
             n += (size_t)sprintf(out + n, "\\u%04x", *c);
+        } else if (u == 0) {
+            n += (size_t)sprintf(out + n, "\\ufffd");
         } else {
-            out[n++] = (char)*c;
+            for (size_t k = 0; k < u; k++) out[n++] = (char)c[k];
+            c += u - 1;
         }
     }
     out[n++] = '"';
@@ -146,7 +152,8 @@ static void write_object(FILE *f, sum_entry_t **e, int n, int depth)
 int io_summary_write(const io_summary_t *s, const char *path)
 {
     if (mpi_rank() != 0) return 0;
-    FILE *f = fopen(path, "w");
+    char tmp[IO_PATH_MAX + 80];
+    FILE *f = atomic_open(path, tmp, sizeof tmp);
     if (!f) return -1;
     sum_entry_t **e = malloc((size_t)(s->n + 1) * sizeof *e);
     for (int i = 0; i < s->n; i++) e[i] = &s->e[i];
@@ -154,7 +161,7 @@ int io_summary_write(const io_summary_t *s, const char *path)
     write_object(f, e, s->n, 0);
     fputs("\n}\n", f);
     free(e);
-    return fclose(f) == 0 ? 0 : -1;
+    return atomic_commit(f, tmp, path);
 }
 
 void io_summary_free(io_summary_t *s)

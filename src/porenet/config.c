@@ -24,7 +24,7 @@ static const cfg_key_t porenet_keys[] = {
      "conductance factor alpha in g = alpha A R_h^2/mu (Catalano eq. 3.4; 1/2: Hagen-Poiseuille analogy)"},
     {"porenet", "wall_throats", CFG_ENUM, "mirror", 1, 0, "mirror|yade",
      "conductance of the throats in a wall plane: mirror (exact symmetry) or yade (YADE FlowEngine's model: one "
-     "merged throat per pore pair, R_h x 2^-1/4 per slip wall; for comparisons with YADE)"},
+     "merged throat per pore pair, R_h x 2^-1/4 per slip wall; for comparisons with YADE; slip walls only)"},
     {"porenet", "solver", CFG_ENUM, "cholmod", 1, 0, "cholmod|pcg",
      "pore-pressure system: CHOLMOD Cholesky (factorised once per triangulation) or Jacobi-preconditioned CG"},
     {"porenet", "pcg_tol", CFG_DOUBLE, "1e-10", 1e-16, 1e-2, NULL, "pcg: relative residual at which CG stops"},
@@ -93,6 +93,15 @@ void pn_model_from_config(cfg_t *cfg, pn_model_t *m)
     m->prm.mu = cfg_double(cfg, "porenet", "viscosity");
     m->prm.alpha = cfg_double(cfg, "porenet", "alpha");
     m->prm.wall_model = cfg_enum(cfg, "porenet", "wall_throats") == 1 ? PN_WALL_YADE : PN_WALL_MIRROR;
+    /* YADE's wall throats are its slip walls (slipBoundary): with a no-slip
+     * wall they conduct more than with a slip one, which cannot be
+     * (docs/theory.md, porenet.wall_throats) */
+    for (int f = 0; f < 6; f++)
+        if (m->prm.wall_model == PN_WALL_YADE && m->dom.noslip[f])
+            cfg_fail(cfg, "porenet", "wall_throats",
+                     "yade reproduces YADE's slip walls only, and face %s is noslip: its wall throats would conduct "
+                     "more than slip ones (use mirror, whose no-slip walls add their area to the wetted perimeter)",
+                     fn[f]);
     m->rho_f = cfg_double(cfg, "porenet", "fluid_density");
     m->kind = cfg_enum(cfg, "porenet", "solver") == 0 ? PN_SOLVER_CHOLMOD : PN_SOLVER_PCG;
     m->tri_kind = cfg_enum(cfg, "porenet", "triangulation") == 0 ? PN_TRI_CGAL : PN_TRI_QHULL;

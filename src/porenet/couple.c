@@ -16,8 +16,6 @@ void pn_model_gather(pn_model_t *m, const dem_t *d)
         m->xid = realloc(m->xid, 3 * (size_t)n * sizeof *m->xid);
         m->rid = realloc(m->rid, (size_t)n * sizeof *m->rid);
     }
-    /* the model keeps its own (id) order: the pore volume rates compare the
-     * positions of the same sphere at two steps */
     for (int i = 0; i < n; i++) {
         const long k = id[i];
         for (int a = 0; a < 3; a++) m->xid[3 * k + a] = x[3 * i + a];

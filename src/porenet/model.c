@@ -19,11 +19,11 @@ void pn_model_free(pn_model_t *m)
     free(m->vol_prev);
     free(m->dvdt);
     free(m->x_prev);
-    free(m->x_tri);
     free(m->f);
     free(m->fp);
     free(m->fv);
     free(m->x_cont);
+    free(m->x_tri);
     free(m->xid);
     free(m->rid);
     free(m->snap_time);

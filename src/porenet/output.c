@@ -16,20 +16,22 @@ static void write_ds(hid_t f, const char *name, hid_t type, int rank, const hsiz
 {
     hid_t sp = H5Screate_simple(rank, dims, NULL);
     hid_t ds = H5Dcreate2(f, name, type, sp, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
+    if (ds < 0 || H5Dwrite(ds, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0) {
+        char file[4096] = "?";
+        H5Fget_name(f, file, sizeof file);
+        io_error("cannot write %s in the HDF5 file %s (HDF5 error, see above)", name, file);
+    }
     H5Dclose(ds);
     H5Sclose(sp);
 }
 
 static void write_xmf(const pn_model_t *m, const char *dir, const long *cnt)
 {
-    char path[4200];
+    if (mpi_rank() != 0) return;
+    char path[4200], tmp[4216];
     snprintf(path, sizeof path, "%s/porenet.xmf", dir);
-    FILE *x = fopen(path, "w");
-    if (!x) {
-        warn("cannot write %s\n", path);
-        return;
-    }
+    FILE *x = atomic_open(path, tmp, sizeof tmp);
+    if (!x) return;
     fprintf(x, "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"2.0\">\n<Domain>\n"
                "<Grid Name=\"porenet\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
     for (int s = 0; s < m->nsnap; s++) {
@@ -81,8 +83,10 @@ static void write_xmf(const pn_model_t *m, const char *dir, const long *cnt)
                 c[3], h5);
     }
     fprintf(x, "</Grid>\n</Domain>\n</Xdmf>\n");
-    fclose(x);
+    atomic_commit(x, tmp, path);
 }
+
+void pn_write_index(const pn_model_t *m, const char *dir) { write_xmf(m, dir, m->snap_counts); }
 
 void pn_write_snapshot(pn_model_t *m, const double *x, const char *dir, double time)
 {
@@ -131,7 +135,7 @@ void pn_write_snapshot(pn_model_t *m, const double *x, const char *dir, double t
     snprintf(path, sizeof path, "%s/porenet_%05d.h5", dir, s);
     hid_t h = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
     if (h < 0) {
-        warn("cannot create %s\n", path);
+        io_error("cannot create the HDF5 file %s (HDF5 error, see above)", path);
     } else {
         hid_t g1 = H5Gcreate2(h, "pores", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
         hsize_t d2[2] = {(hsize_t)nv, 3}, d4[2] = {(hsize_t)ntt, 4}, d1 = (hsize_t)ntt;
@@ -165,7 +169,11 @@ void pn_write_snapshot(pn_model_t *m, const double *x, const char *dir, double t
         write_ds(g3, "radius", H5T_NATIVE_DOUBLE, 1, &s1, rad);
         free(rad);
         H5Gclose(g3);
-        H5Fclose(h);
+        if (H5Fclose(h) < 0) {
+            io_error("cannot write the HDF5 file %s (HDF5 error, see above)", path);
+            mpi_finalize_unsafe(); /* the file is left half closed (HDF5 1.10) */
+        }
+        else fsync_path(path); /* on the disk before the next checkpoint */
     }
     counts[4 * s] = nv;
     counts[4 * s + 1] = ntt;
