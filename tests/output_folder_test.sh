@@ -41,8 +41,10 @@ report $? "output.overwrite = true: the earlier files are deleted, the folder is
 
 # 2. the lock: one run at a time
 B=$T/busy
-setsid $BIN run $CAV --set time.max_steps=100000 --set output.checkpoint_every=50 --set output.checkpoint_keep=2 \
-    --out $B >$T/b1.log 2>&1 &
+# the busy run lasts until it is killed (t_end far) and keeps every checkpoint (the one the
+# restart below names must not be pruned while this script polls for it)
+setsid $BIN run $CAV --set time.max_steps=100000 --set time.t_end=100000 --set output.checkpoint_every=50 \
+    --set output.checkpoint_keep=0 --out $B >$T/b1.log 2>&1 &
 pid=$!
 for i in $(seq 400); do [ -e $B/checkpoint_00000050.h5 ] && break; sleep 0.025; done
 $BIN run $CAV --set time.max_steps=20 --set output.overwrite=true --out $B >$T/b2.log 2>&1
@@ -55,7 +57,7 @@ wait $pid 2>/dev/null
     grep -q "another run writes into this folder" $T/b3.log
 report $? "a second run into a busy folder is refused, new (exit $rc2) or restarted (exit $rc3), naming the process"
 ck=$(ls $B/checkpoint_*.h5 | tail -1)
-$BIN run $CAV --set time.max_steps=100000 --set output.checkpoint_every=50 --set output.checkpoint_keep=2 \
+$BIN run $CAV --set time.t_end=100000 --set output.checkpoint_every=50 --set output.checkpoint_keep=0 \
     --set time.max_steps=$(($(basename $ck .h5 | sed 's/checkpoint_0*//') + 10)) --out $B --restart $ck >$T/b4.log 2>&1
 report $? "the lock goes with the run that held it, even killed with -9: the restart runs"
 

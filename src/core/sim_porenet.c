@@ -40,9 +40,9 @@ typedef struct {
     int failed;         /* the last step failed (m.err): the run diverged */
     /* the state at the start of the step (rollback) */
     struct {
-        long n_retri, n_steps;
+        long n_retri, n_steps, kept_count;
         int vol_current, npore, n;
-        double eps_acc, q[6], kappa[3];
+        double eps_acc, q[6], kappa[3], kept_sum, kept_min;
         double *p, *vol, *vol_prev, *x_prev, *f, *x_tri;
     } prev;
     int snapshots;      /* write the network at the run's snapshot times */
@@ -263,6 +263,9 @@ static void part_keep_previous(void *ctx)
     pp->prev.npore = m->net.npore;
     pp->prev.n = m->n;
     pp->prev.eps_acc = m->eps_acc;
+    pp->prev.kept_count = m->kept_count;
+    pp->prev.kept_sum = m->kept_sum;
+    pp->prev.kept_min = m->kept_min;
     memcpy(pp->prev.q, pp->q, sizeof pp->q);
     memcpy(pp->prev.kappa, pp->kappa, sizeof pp->kappa);
     pp->prev.p = copy_of(pp->prev.p, m->p, np);
@@ -302,6 +305,10 @@ static void part_restore_previous(void *ctx)
     porenet_part_t *pp = ctx;
     set_state(pp, pp->prev.n_retri, pp->prev.n_steps, pp->prev.vol_current, pp->prev.eps_acc, pp->prev.x_tri,
               pp->prev.p, pp->prev.vol, pp->prev.vol_prev, pp->prev.x_prev, pp->prev.f);
+    /* the re-meshing statistics as before the step (set_state's rebuild is not a re-meshing of the run) */
+    pp->m.kept_count = pp->prev.kept_count;
+    pp->m.kept_sum = pp->prev.kept_sum;
+    pp->m.kept_min = pp->prev.kept_min;
     memcpy(pp->q, pp->prev.q, sizeof pp->q);
     memcpy(pp->kappa, pp->prev.kappa, sizeof pp->kappa);
     pp->failed = 0; /* the DEM part brought back its external forces */
