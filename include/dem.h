@@ -162,6 +162,21 @@ void dem_set_step_observer(dem_t *d, void (*fn)(dem_t *d, void *ctx), void *ctx)
  * the stored velocities are half-step values). */
 void dem_full_velocity(const dem_t *d, int i, double vel[3]);
 
+/* Force statistics of a flow (the force balance of Izard 2014 eq. 4.16):
+ * over the sub-steps since the last take, the sums of Σ |F_pair| and of the
+ * number of contacts (particle pairs and walls), and of Σ |F_lub| and of
+ * the number of pairs (and particle–wall gaps) under the normal
+ * lubrication.  Collected once enabled; take is collective and resets. */
+typedef struct {
+    long steps;
+    double contact_norm, contacts;
+    double lub_norm, lubricated;
+} dem_force_stats_t;
+void dem_force_stats_enable(dem_t *d, int on);
+void dem_force_stats_take(dem_t *d, dem_force_stats_t *out);
+/* Wall time spent in the normal and tangential lubrication (s, this rank). */
+double dem_lubrication_seconds(const dem_t *d);
+
 /* Bytes allocated by the DEM per particle (particles, lists, cells, walls). */
 double dem_memory_per_particle(const dem_t *d);
 

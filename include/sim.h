@@ -31,7 +31,7 @@
 #include "porenet.h"
 
 #define SIM_MAX_PARTS 8
-#define SIM_MAX_COLS 96
+#define SIM_MAX_COLS 128
 
 typedef struct sim sim_t;
 
@@ -135,6 +135,8 @@ struct sim {
     long step_prev;
     double dt_prev;
     double wall0, wall_step; /* start of the run; wall time of the last step */
+    double part_wall[SIM_MAX_PARTS]; /* wall time in each part's advance, this run (summary.json "cost") */
+    double output_wall;      /* wall time in the outputs (series, snapshots, checkpoints), this run */
     long step0;              /* step at the start of this run (restart) */
     sim_status_t status;
     char why[512];           /* why the run diverged or halted */
@@ -226,6 +228,10 @@ void sim_dem_set_driven(sim_t *s);
 /* The coupling part (sim_coupling.c): resolved IBM–DEM exchange (ibm != NULL)
  * and the restitution measurements. */
 void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm);
+/* The measurements of a flow down an inclined plane ([avalanche], sim_avalanche.c), after
+ * every other part; ibm: the immersed spheres of the particles (NULL without a resolved fluid). */
+void sim_avalanche_register_keys(void);
+void sim_add_avalanche(sim_t *s, cfg_t *cfg, struct ibm *ibm);
 void sim_coupling_register_keys(void);
 /* The scene's fluid model is the resolved fluid ([coupling] fluid, fluid_model.h). */
 int sim_fluid_enabled(cfg_t *cfg);

@@ -169,9 +169,11 @@ static void test_pair_first_integral(void **state)
     const double gap_end = fabs(x[5] - x[2]) - 2 * R, expect = exp(Lpot(gap0, eta, range, 0) - St) - eta;
     printf("pair St=6: invariant error %.2e, momentum error %.2e, final gap %.6e R (exact %.6e R)\n", worst,
            worst_p, gap_end / R, expect / R);
-    /* Newton tolerance 1e-15 of the bracket (~1.4 u0) per step, 2e4 steps, plus rounding */
+    /* Newton tolerance 1e-14 |u| per step, 2e4 steps, plus rounding; the momentum changes only by
+     * the rounding of the two velocity updates of each step (±J/m, velocities up to 2 P0/m): a
+     * random walk of 2e4 steps of a few 1e-16 P0, measured 0.9–1.2e-13 */
     assert_true(worst < 1e-9);
-    assert_true(worst_p < 1e-13);
+    assert_true(worst_p < 5e-13);
     assert_true(fabs(gap_end - expect) < 1e-6 * expect);
     dem_free(d);
 }

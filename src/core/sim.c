@@ -293,8 +293,11 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
     names[nc++] = "step";
     names[nc++] = "time";
     names[nc++] = "dt";
-    for (int i = 0; i < s->npart; i++)
-        for (int c = 0; c < s->part[i].ncol && nc < SIM_MAX_COLS - 1; c++) names[nc++] = s->part[i].col_names[c];
+    for (int i = 0; i < s->npart; i++) {
+        if (nc + s->part[i].ncol > SIM_MAX_COLS - 1)
+            die("series.csv: more than %d columns (SIM_MAX_COLS) with the part %s", SIM_MAX_COLS, s->part[i].name);
+        for (int c = 0; c < s->part[i].ncol; c++) names[nc++] = s->part[i].col_names[c];
+    }
     names[nc++] = "wall_per_step";
     char path[IO_PATH_MAX + 16];
     io_outdir_path(&s->out, "series.csv", path, sizeof path);
@@ -332,9 +335,15 @@ static void advance(sim_t *s, double dt)
             if (s->part[i].keep_previous) s->part[i].keep_previous(s->part[i].ctx);
     s->time_prev = s->time;
     s->step_prev = s->step;
-    double w0 = wtime();
+    const double w0 = wtime();
+    double wp = w0;
     for (int i = 0; i < s->npart; i++)
-        if (s->part[i].advance) s->part[i].advance(s->part[i].ctx, dt);
+        if (s->part[i].advance) {
+            s->part[i].advance(s->part[i].ctx, dt);
+            const double w = wtime();
+            s->part_wall[i] += w - wp;
+            wp = w;
+        }
     s->wall_step = wtime() - w0;
     s->time += dt;
     s->step++;
@@ -437,7 +446,7 @@ static void write_series_row(sim_t *s)
 
 /* The outputs due after this step.  Returns -1 (every rank) after an I/O
  * error: a write failed somewhere (io_check_errors). */
-static int outputs(sim_t *s)
+static int outputs_due(sim_t *s)
 {
     if (s->step % s->prm.series_every == 0) write_series_row(s);
     if (s->time >= s->next_fields * (1.0 - 1e-12)) write_fields(s);
@@ -456,6 +465,15 @@ static int outputs(sim_t *s)
     }
     io_progress_update(&s->progress, s->time, s->step, frac);
     return io_check_errors(s->comm, s->io_why, sizeof s->io_why) ? -1 : 0;
+}
+
+/* The outputs, timed (summary.json "cost"). */
+static int outputs(sim_t *s)
+{
+    const double w0 = wtime();
+    const int rc = outputs_due(s);
+    s->output_wall += wtime() - w0;
+    return rc;
 }
 
 static void write_summary(sim_t *s)
@@ -479,6 +497,14 @@ static void write_summary(sim_t *s)
     io_summary_double(y, "steps_per_second", wall > 0 ? (s->step - s->step0) / wall : 0.0);
     io_summary_long(y, "peak_rss_bytes_rank0", peak_rss_bytes());
     if (s->restart_path[0]) io_summary_string(y, "restarted_from", s->restart_path);
+    /* the wall time of this run in each part's advance and in the outputs (rank 0) */
+    for (int i = 0; i < s->npart; i++)
+        if (s->part[i].advance) {
+            char key[96];
+            snprintf(key, sizeof key, "cost.%s_seconds", s->part[i].name);
+            io_summary_double(y, key, s->part_wall[i]);
+        }
+    io_summary_double(y, "cost.output_seconds", s->output_wall);
     if (s->last_checkpoint[0]) io_summary_string(y, "checkpoint", s->last_checkpoint);
     for (int i = 0; i < s->npart; i++)
         if (s->part[i].summary) s->part[i].summary(s->part[i].ctx, y, s->part[i].name);

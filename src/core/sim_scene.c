@@ -32,6 +32,7 @@ void sim_build_scene(sim_t *s, cfg_t *cfg)
             struct ibm *ibm = sim_add_ibm_with(s, cfg, sp, n);
             free(sp);
             sim_add_coupling(s, cfg, ibm);
+            if (cfg_has_section(cfg, "avalanche")) sim_add_avalanche(s, cfg, ibm);
         } else if (cfg_has_section(cfg, "ibm")) {
             sim_add_ibm(s, cfg);
         }
@@ -45,6 +46,7 @@ void sim_build_scene(sim_t *s, cfg_t *cfg)
     if (model == FLUID_MODEL_PORENET) sim_add_porenet(s, cfg);
     if (model == FLUID_MODEL_PORENET && cfg_has_section(cfg, "oedometer")) sim_add_oedometer(s, cfg);
     if (particles && cfg_enum(cfg, "coupling", "restitution") != 0) sim_add_coupling(s, cfg, NULL);
+    if (particles && cfg_has_section(cfg, "avalanche")) sim_add_avalanche(s, cfg, NULL);
     if (s->npart == 0) {
         if (mpi_rank() == 0) {
             char secs[128] = "";

@@ -251,6 +251,7 @@ void dem_compute_forces(dem_t *d)
     d->n_contacts = d->n_wall_contacts = 0;
     d->max_overlap = 0.0;
     d->law->pair_forces(d);
+    if (d->fstat.on) d->fstat.contacts += (double)d->n_contacts;
     double t1 = wtime();
     d->t_pair += t1 - t0;
     for (int w = 0; w < d->nwall; w++) {
@@ -262,6 +263,10 @@ void dem_compute_forces(dem_t *d)
     }
     double t2 = wtime();
     d->t_wall += t2 - t1;
+    if (d->fstat.on) {
+        d->fstat.steps++;
+        d->fstat.contacts += (double)d->n_wall_contacts;
+    }
     if (d->split) {
         MPI_Allreduce(MPI_IN_PLACE, d->f, 3 * d->n, MPI_DOUBLE, MPI_SUM, d->comm);
         MPI_Allreduce(MPI_IN_PLACE, d->t, 3 * d->n, MPI_DOUBLE, MPI_SUM, d->comm);
@@ -368,7 +373,11 @@ static double kick_drift(dem_t *d)
         /* the drag (implicit in the velocity) and the lubrication impulses of
          * this drift (implicit in the gap it produces), then the drift */
         if (d->drag.on) dem_drag_impulses(d, d->dt);
-        if (d->lub.on) dem_lubrication_impulses(d, d->dt);
+        if (d->lub.on) {
+            const double wl = wtime();
+            dem_lubrication_impulses(d, d->dt);
+            d->t_lub += wtime() - wl;
+        }
         vmax2 = 0.0;
         for (int i = 0; i < n; i++) {
             if (fixed[i]) continue;
@@ -645,6 +654,23 @@ double dem_memory_per_particle(const dem_t *d)
     for (int w = 0; w < d->nwall; w++) bytes += (double)d->wall[w].cap * (sizeof(int) + 1 + 3 * sizeof(double));
     return bytes / n;
 }
+
+void dem_force_stats_enable(dem_t *d, int on) { d->fstat.on = on; }
+
+void dem_force_stats_take(dem_t *d, dem_force_stats_t *out)
+{
+    double c[2] = {d->fstat.contact_norm, d->fstat.contacts};
+    if (d->split) MPI_Allreduce(MPI_IN_PLACE, c, 2, MPI_DOUBLE, MPI_SUM, d->comm);
+    out->steps = d->fstat.steps;
+    out->contact_norm = c[0];
+    out->contacts = c[1];
+    out->lub_norm = d->fstat.lub_norm;
+    out->lubricated = d->fstat.lubricated;
+    d->fstat.steps = 0;
+    d->fstat.contact_norm = d->fstat.contacts = d->fstat.lub_norm = d->fstat.lubricated = 0.0;
+}
+
+double dem_lubrication_seconds(const dem_t *d) { return d->t_lub; }
 
 void dem_print_timers(const dem_t *d)
 {

@@ -217,8 +217,16 @@ struct dem {
     double *snap_t;
     long *snap_n;
     int *snap_index;
+    /* force statistics since the last dem_force_stats_take (on this rank; the
+     * contacts are reduced over the ranks of a split run when taken) */
+    struct {
+        int on;
+        long steps;
+        double contact_norm, contacts; /* Σ |F| and count of the contacts (pairs and walls) */
+        double lub_norm, lubricated;   /* the same for the normal lubrication (every rank computes all) */
+    } fstat;
     /* timers */
-    double t_pair, t_wall, t_build, t_integ, t_comm;
+    double t_pair, t_wall, t_build, t_integ, t_comm, t_lub;
 };
 
 /* ---- neighbour search (dem_neigh.c) ---- */

@@ -73,44 +73,59 @@ static inline double lub_potential_slope(const lub_pair_t *p, double delta)
     return 1.0 / (delta + p->eta) - p->sub;
 }
 
+/* L(δ₀) − L(δ₀ − s), the change of the potential over a drift s.  Where both
+ * gaps are inside (0, Δ_lub) it is ln(1 + ε) − s/(Δ_lub + η_e) with
+ * ε = s/(δ₀ − s + η_e), summed as a series when |ε| < 1e-3 (the next term,
+ * ε⁶/6, is below 2e-16 of the sum): the drift of a sub-step is small against
+ * the gap, and the solve needs no logarithm.  Elsewhere from L itself, with
+ * L(δ₀) computed once (*L0, NAN until needed). */
+static inline double lub_delta_potential(const lub_pair_t *p, double gap0, double s, double *L0)
+{
+    const double d1 = gap0 - s;
+    if (gap0 > 0 && gap0 < p->range && d1 > 0 && d1 < p->range) {
+        const double e = s / (d1 + p->eta);
+        const double l = fabs(e) < 1e-3 ? e * (1.0 - e * (0.5 - e * (1.0 / 3.0 - e * (0.25 - 0.2 * e)))) : log1p(e);
+        return l - s * p->sub;
+    }
+    if (isnan(*L0)) *L0 = lub_potential(p, gap0);
+    return *L0 - lub_potential(p, d1);
+}
+
 /* Root u′ of g(u′) = m (u′ − u) + k [L(δ₀) − L(δ₀ − dt u′)] = 0.
  *
  * Bracket.  g′ = m + k dt L′ ≥ m, and g(0) = −m u, so the root lies between
  * 0 and u (the impulse never reverses the approach) and within |g(u)|/m of
- * u: between u and u − g(u)/m, the explicit impulse over the undamped drift.
- * With overlap = off L is bounded and the original bracket u ± k ΔL/m (ΔL =
- * L(Δ_lub) − L(0)), which contains both, is kept with its tolerance scale:
- * `off` stays bit-identical to the code before the option existed.  With
- * overlap = saturated L is unbounded below (linear for δ < 0), so only the
- * tight bracket is finite: the interval between u and
- * clamp(u − g(u)/m, between 0 and u), tolerance scale |u|. */
+ * u: between u and clamp(u − g(u)/m, between 0 and u), the explicit impulse
+ * over the undamped drift (finite also with overlap = saturated, whose L is
+ * unbounded below).  Newton starts from the linearly implicit step (the
+ * damping −k L′(δ₀) u′ over dt), the root itself when the gap changes little
+ * over the step, and is safeguarded by bisection; tolerance 1e-14 |u|. */
 static double lub_solve(const lub_pair_t *p, double m, double k, double dt, double gap0, double u)
 {
-    const double L0 = lub_potential(p, gap0);
-    double lo, hi, scale;
-    if (!p->overlap) {
-        scale = k * (lub_potential(p, p->range) - lub_potential(p, 0.0)) / m;
-        lo = u - scale;
-        hi = u + scale;
-    } else {
-        const double explicit_u = u - k * (L0 - lub_potential(p, gap0 - dt * u)) / m;
-        const double far = u > 0 ? fmax(explicit_u, 0.0) : fmin(explicit_u, 0.0);
-        lo = fmin(u, far);
-        hi = fmax(u, far);
-        scale = fabs(u);
-    }
-    double x = u;
+    if (u == 0) return 0.0;
+    double L0 = NAN;
+    const double explicit_u = u - k * lub_delta_potential(p, gap0, dt * u, &L0) / m;
+    const double far = u > 0 ? fmax(explicit_u, 0.0) : fmin(explicit_u, 0.0);
+    double lo = fmin(u, far), hi = fmax(u, far);
+    if (!(hi > lo)) return u; /* no impulse: outside the range over the whole drift */
+    const double scale = fabs(u);
+    double x = u * m / (m + k * dt * lub_potential_slope(p, gap0));
+    if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
     for (int it = 0; it < 200; it++) {
-        const double g = m * (x - u) + k * (L0 - lub_potential(p, gap0 - dt * x));
+        const double g = m * (x - u) + k * lub_delta_potential(p, gap0, dt * x, &L0);
         if (g == 0) return x;
         if (g > 0)
             hi = x;
         else
             lo = x;
         const double dg = m + k * dt * lub_potential_slope(p, gap0 - dt * x);
-        double xn = x - g / dg;
+        const double step = g / dg;
+        /* converged: the Newton step is below 1e-14 |u| (it lands on the bracket's end when the
+         * root is that close to it, and bisection would halve the last ulps for nothing) */
+        if (fabs(step) <= 1e-14 * scale) return fmin(fmax(x - step, lo), hi);
+        double xn = x - step;
         if (!(xn > lo && xn < hi)) xn = 0.5 * (lo + hi);
-        if (fabs(xn - x) <= 1e-15 * (fabs(x) + scale) || hi - lo <= 1e-15 * (fabs(x) + scale)) return xn;
+        if (hi - lo <= 1e-14 * scale) return xn;
         x = xn;
     }
     return x;
@@ -213,6 +228,10 @@ void dem_lubrication_impulses(dem_t *d, double dt)
             const double m = 1.0 / (invm[i] + invm[j]), reff = ri * rj / (ri + rj);
             const double du = lub_solve(&p, m, k0 * reff * reff, dt, gap0, u) - u; /* change of the approach speed */
             const double J = m * du;                                                /* impulse along n on i */
+            if (d->fstat.on) {
+                d->fstat.lub_norm += fabs(J) / dt;
+                d->fstat.lubricated += 1.0;
+            }
             for (int a = 0; a < 3; a++) {
                 v[3 * i + a] += J * invm[i] * n[a];
                 v[3 * j + a] -= J * invm[j] * n[a];
@@ -236,6 +255,10 @@ void dem_lubrication_impulses(dem_t *d, double dt)
                 if ((gap0 >= p.range && gap1 >= p.range) || (!p.overlap && gap0 <= 0 && gap1 <= 0)) continue;
                 const double m = 1.0 / invm[i];
                 const double du = lub_solve(&p, m, k0 * r[i] * r[i], dt, gap0, u) - u;
+                if (d->fstat.on) {
+                    d->fstat.lub_norm += m * fabs(du) / dt;
+                    d->fstat.lubricated += 1.0;
+                }
                 /* the approach speed changes by du: v changes by −du n */
                 for (int a = 0; a < 3; a++) {
                     v[3 * i + a] -= du * W->n[a];
