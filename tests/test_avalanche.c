@@ -98,7 +98,9 @@ static void test_lattice(void **state)
     const int kc = 5 * 1 + 2; /* slab [1.4 D, 1.6 D] around the centre of layer 1 */
     assert_true(fabs(av.grain[4 * kc + 1] / av.grain[4 * kc] - (a + b * 1.5 * D)) < 1e-13);
     /* the flow time V_g / Q̄ and the window: a step outside adds nothing, means weight by the steps */
-    assert_true(fabs(avalanche_flow_time(&av) - L * L * NL * D * L / Q) < 1e-12 * avalanche_flow_time(&av));
+    /* V_g = L W h: the time the grains take to flow through the box, L/(phi U) */
+    assert_true(fabs(avalanche_flow_time(&av) - L * L * NL * D / Q) < 1e-12 * avalanche_flow_time(&av));
+    assert_true(fabs(avalanche_flow_time(&av) - L / (M_PI / 6 * av.now[AV_U])) < 1e-12 * avalanche_flow_time(&av));
     avalanche_sample_grains(&av, d, NULL, NULL, 2.0, 0.5); /* middle 1.75: outside [0, 1] */
     assert_true(fabs(av.tw - 0.5) < 1e-15);
     avalanche_free(&av);

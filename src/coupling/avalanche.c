@@ -261,7 +261,7 @@ double avalanche_mean(const avalanche_t *a, int col) { return a->tw > 0 ? a->sca
 double avalanche_flow_time(const avalanche_t *a)
 {
     const double Q = avalanche_mean(a, AV_Q), h = avalanche_mean(a, AV_H);
-    return Q > 0 ? a->area * h * a->Ls / Q : INFINITY;
+    return Q > 0 ? a->area * h / Q : INFINITY;
 }
 
 int avalanche_write_profiles(const avalanche_t *a, const char *path)

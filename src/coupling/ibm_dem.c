@@ -75,11 +75,13 @@ void coupling_added_mass_apply(const coupling_added_mass_t *am, dem_t *d, double
 void coupling_added_mass_after_step(coupling_added_mass_t *am, const dem_t *d)
 {
     const long *id = dem_ids(d);
+    const unsigned char *fx = dem_fixed(d);
     for (int i = 0; i < dem_count(d); i++) {
         const long p = id[i];
         double U[3];
         dem_full_velocity(d, i, U);
-        for (int a = 0; a < 3; a++) am->dU[3 * p + a] = U[a] - am->U0[3 * p + a] - am->slow[3 * p + a];
+        /* a fixed particle (infinite mass) takes no collision velocity change */
+        for (int a = 0; a < 3; a++) am->dU[3 * p + a] = fx[i] ? 0.0 : U[a] - am->U0[3 * p + a] - am->slow[3 * p + a];
     }
 }
 
@@ -123,7 +125,7 @@ void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const 
             fe[3 * i + a] = F[a] - rho_fluid * V * gravity[a];
             te[3 * i + a] = F[3 + a];
         }
-        if (am) {
+        if (am && !dem_fixed(d)[i]) {
             /* the DEM's inertia is m* = m_p + C_M ρ V: the held force scaled by m* over m_p keeps the acceleration
              * (F_h − ρ V g)/m_p + g of the forces that are not the collision's */
             const double mstar = dem_mass(d, i), mp = dem_density(d, i) * V;
