@@ -8,6 +8,8 @@
 #                   RESTITUTION_OUT=dir the output directory (default build/restitution)
 #   make viscous_stability  the stability map of the coupled step at large viscous numbers
 #                   (build/viscous_stability/map.md; ~25 min on 2 cores)
+#   make avalanche  the immersed avalanche's regime map in the quick box (build/avalanche/map.md, map_map.png);
+#                   make avalanche_production: Table 4.3 in the production box
 #   make bounce     the bouncing sphere against experiments, lubrication cut-off, oblique bounces (FULL=1: finer)
 #   make fuzz       the long fuzz series of tests/fuzz.py (40 check and 8 run mutants of every case file;
 #                   FUZZ_SEED=N other mutants, FUZZ_ARGS='--checks 200' more); make test runs a quick subset
@@ -45,7 +47,7 @@ BIN     := $(BUILD)/ibmdem
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 BENCHES := $(patsubst bench/%.c,$(BUILD)/bench/%,$(wildcard bench/bench_*.c))
 
-.PHONY: all test demo validate bench deps clean restitution viscous_stability bounce fuzz
+.PHONY: all test demo validate bench deps clean restitution viscous_stability bounce fuzz avalanche avalanche_production
 all: $(BIN) $(TESTS) $(BENCHES)
 
 $(BUILD)/obj/%.o: src/%.c
@@ -113,6 +115,14 @@ restitution: deps
 viscous_stability: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bash scripts/viscous_stability.sh $(BUILD)/viscous_stability
+# the immersed avalanche (Izard ch. 4): the regime map and Table 4.3 in the quick box, build/avalanche/map*;
+# avalanche_production: Table 4.3 in the production box (several hours on 2 cores)
+avalanche: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bash scripts/avalanche.sh $(BUILD)/avalanche map
+avalanche_production: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bash scripts/avalanche.sh $(BUILD)/avalanche production
 # the bouncing sphere against the experiments of Gondret et al. (2002), the lubrication cut-off and the
 # oblique bounces (part of make validate); FULL=1 adds D/dx = 40 (and 30 at St 152): about 3 hours
 bounce: deps

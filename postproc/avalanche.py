@@ -66,15 +66,31 @@ def summarise(run):
     return row
 
 
+# Table 4.3 of the thesis: (rho_p/rho, St) -> regime
+THESIS = {(4, 0.04): "viscous", (4, 0.31): "viscous", (4, 7.75): "inertial", (4, 75.4): "inertial",
+          (100, 0.45): "viscous", (100, 4.5): "free fall", (100, 111.2): "free fall"}
+
+
+def regime(r):
+    """The thesis' method (§2.2 of the reference notes): the regime whose time scale the flow time
+    follows, T/T_v ~ 1 (viscous), T/T_i ~ 1 (inertial), T/T_ff ~ 1 (free fall): the nearest in log."""
+    d = {"viscous": abs(math.log(r["T_Tv"])), "inertial": abs(math.log(r["T_Ti"])),
+         "free fall": abs(math.log(r["T_Tff"]))}
+    return min(d, key=d.get)
+
+
 def table(rows):
-    out = ["| run | ρ_p/ρ | St | r | T (ms) | T √(g/D) | T/T_v | T/T_i | T/T_ff | φ | h_g/D | "
+    out = ["| run | ρ_p/ρ | St | r | T (ms) | T √(g/D) | T/T_v | T/T_i | T/T_ff | regime (thesis) | φ | h_g/D | "
            "shares per contact c/lub/h | shares per grain c/lub/h | window √(D/g) | wall (s) |",
-           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         sc, sg = r["share_c"], r["share_g"]
-        out.append("| %s | %g | %.3g | %.3g | %.4g | %.4g | %.3g | %.3g | %.3g | %.3f | %.2f | %.2f/%.2f/%.2f | "
+        th = next((v for (q, st), v in THESIS.items() if abs(r["ratio"] - q) < 1e-6 * q and abs(r["St"] / st - 1) < 0.05),
+                  None)
+        lab = regime(r) + (" (%s)" % th if th else "")
+        out.append("| %s | %g | %.3g | %.3g | %.4g | %.4g | %.3g | %.3g | %.3g | %s | %.3f | %.2f | %.2f/%.2f/%.2f | "
                    "%.2f/%.2f/%.2f | %.0f | %.0f |" % (
-                       r["run"], r["ratio"], r["St"], r["r"], r["T_ms"], r["T_g"], r["T_Tv"], r["T_Ti"], r["T_Tff"],
+                       r["run"], r["ratio"], r["St"], r["r"], r["T_ms"], r["T_g"], r["T_Tv"], r["T_Ti"], r["T_Tff"], lab,
                        r["phi"], r["h_D"], sc["contact"], sc["lubrication"], sc["hydrodynamic"], sg["contact"],
                        sg["lubrication"], sg["hydrodynamic"], r["window_g"], r["wall"]))
     return "\n".join(out) + "\n"
@@ -85,6 +101,7 @@ def main():
     ap.add_argument("runs", nargs="+")
     ap.add_argument("--out", default="avalanche")
     ap.add_argument("--labels", default=None)
+    ap.add_argument("--map", action="store_true", help="also the regime map (St, r) with the thesis' lines")
     a = ap.parse_args()
     rows = [summarise(r) for r in a.runs]
     with open(a.out + ".md", "w") as f:
@@ -96,6 +113,26 @@ def main():
         import matplotlib.pyplot as plt
     except ImportError:
         return
+    if a.map:
+        fig, ax = plt.subplots(figsize=(6, 4.5))
+        mk = {"viscous": ("o", "tab:blue"), "inertial": ("s", "tab:orange"), "free fall": ("^", "tab:green")}
+        for lab, (m, c) in mk.items():
+            pts = [(r["St"], r["r"]) for r in rows if regime(r) == lab]
+            if pts:
+                ax.scatter(*zip(*pts), marker=m, color=c, label=lab)
+        ax.plot([1, 1], [4, 20], "k-", lw=1, label="Izard: St = 1 (r ≥ 4), r = 4 St")
+        ax.plot([0.25, 1], [1, 4], "k-", lw=1)
+        ax.plot([1, 1e3], [4, 4], "k:", lw=1)
+        ax.plot([10, 10], [4, 20], "r--", lw=1, label="Courrech du Pont: St = 10, r = 0.4 St, r = 4")
+        ax.plot([2.5, 10], [1, 4], "r--", lw=1)
+        ax.plot([10, 1e3], [4, 4], "r:", lw=1)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("St")
+        ax.set_ylabel("r")
+        ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(a.out + "_map.png", dpi=120)
     labels = a.labels.split(",") if a.labels else [r["run"] for r in rows]
     fig, ax = plt.subplots(1, 2, figsize=(9, 4.5))
     for run, lab in zip(a.runs, labels):

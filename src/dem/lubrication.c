@@ -93,21 +93,17 @@ static inline double lub_delta_potential(const lub_pair_t *p, double gap0, doubl
 
 /* Root u′ of g(u′) = m (u′ − u) + k [L(δ₀) − L(δ₀ − dt u′)] = 0.
  *
- * Bracket.  g′ = m + k dt L′ ≥ m, and g(0) = −m u, so the root lies between
- * 0 and u (the impulse never reverses the approach) and within |g(u)|/m of
- * u: between u and clamp(u − g(u)/m, between 0 and u), the explicit impulse
- * over the undamped drift (finite also with overlap = saturated, whose L is
- * unbounded below).  Newton starts from the linearly implicit step (the
+ * Bracket.  g′ = m + k dt L′ ≥ m > 0, g(0) = −m u and g(u) has the sign of
+ * u (L increases), so the root lies between 0 and u: the impulse never
+ * reverses the approach (a finite bracket also with overlap = saturated,
+ * whose L is unbounded below).  Newton starts from the linearly implicit step (the
  * damping −k L′(δ₀) u′ over dt), the root itself when the gap changes little
  * over the step, and is safeguarded by bisection; tolerance 1e-14 |u|. */
 static double lub_solve(const lub_pair_t *p, double m, double k, double dt, double gap0, double u)
 {
     if (u == 0) return 0.0;
     double L0 = NAN;
-    const double explicit_u = u - k * lub_delta_potential(p, gap0, dt * u, &L0) / m;
-    const double far = u > 0 ? fmax(explicit_u, 0.0) : fmin(explicit_u, 0.0);
-    double lo = fmin(u, far), hi = fmax(u, far);
-    if (!(hi > lo)) return u; /* no impulse: outside the range over the whole drift */
+    double lo = fmin(u, 0.0), hi = fmax(u, 0.0);
     const double scale = fabs(u);
     double x = u * m / (m + k * dt * lub_potential_slope(p, gap0));
     if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);

@@ -1,0 +1,47 @@
+#!/bin/bash
+# avalanche.sh OUT [map|table|production|all] — the immersed avalanche of Izard (2014) ch. 4
+# (docs/validation.md "Immersed avalanche"; cases/avalanche/README.md).
+#   map         the regime map: rho_p/rho in {2.7, 4, 10, 40, 100} x St in {0.05, 0.3, 1, 4.5, 20, 100}
+#               (30 runs) and the seven cases of Table 4.3, in the quick box (coarse.ini: 3 D x 3 D,
+#               D/dx = 5, soft contacts) to 300 sqrt(D/g), averaged from 150 sqrt(D/g)
+#   production  the seven cases of Table 4.3 in the production box (case.ini: 5 D x 5 D x 20 D,
+#               D/dx = 10, the thesis' contacts) to 300 sqrt(D/g), averaged from 200 sqrt(D/g)
+# Runs two at a time; each run's folder, then OUT/<set>.md (the table with regime labels by the
+# thesis' method) and OUT/<set>_map.png, OUT/<set>_profiles.png, OUT/<set>_series.png.
+set -u
+OUT=${1:?usage: avalanche.sh OUT [map|production|all]}
+WHAT=${2:-map}
+cd "$(dirname "$0")/.."
+BUILD=${BUILD:-build}
+BIN=$PWD/$BUILD/ibmdem
+PY=/usr/bin/python3
+mkdir -p "$OUT"
+TG=0.022589578612141028 # sqrt(D/g), D = 5.006 mm
+
+table43="4:0.04 4:0.31 4:7.75 4:75.4 100:0.45 100:4.5 100:111.2"
+run_set() { # SET CASE T_END_G AVG_FROM_G "RATIO:ST ..."
+    local set=$1 case=$2 tend=$3 avg=$4 list=$5 dirs=() pids=()
+    for rs in $list; do
+        local ratio=${rs%%:*} st=${rs##*:} dir="$OUT/$set/r${rs%%:*}_St${rs##*:}"
+        dirs+=("$dir")
+        mkdir -p "$OUT/$set"
+        [ -f "$dir/summary.json" ] && continue # done already
+        local opts
+        opts=$($PY scripts/avalanche_set.py "$ratio" "$st" 2>/dev/null)
+        $BIN run "$case" $opts --set output.progress=off --set output.overwrite=true \
+            --set time.t_end=$($PY -c "print($tend * $TG)") \
+            --set avalanche.average_from=$($PY -c "print($avg * $TG)") --out "$dir" >"$dir.log" 2>&1 &
+        pids+=($!)
+        if [ ${#pids[@]} -ge 2 ]; then wait "${pids[0]}"; pids=("${pids[@]:1}"); fi
+    done
+    wait
+    $PY postproc/avalanche.py "${dirs[@]}" --out "$OUT/$set" --map
+}
+case $WHAT in
+map | all)
+    grid=""
+    for r in 2.7 4 10 40 100; do for s in 0.05 0.3 1 4.5 20 100; do grid="$grid $r:$s"; done; done
+    run_set map cases/avalanche/coarse.ini 300 150 "$table43$grid" ;;&
+production | all)
+    run_set production cases/avalanche/case.ini 300 200 "$table43" ;;
+esac
