@@ -37,6 +37,8 @@
 
 static const double D = 1e-3, RHO_P = 2500, RHO_F = 1000, MU = 0.1, G = 9.81, TC = 1e-4;
 
+static double gravity_z = -G; /* of the scenes made by make() */
+
 static dem_t *make(const char *particles, const char *drag_keys, const char *boundary)
 {
     char text[4096];
@@ -47,7 +49,7 @@ static dem_t *make(const char *particles, const char *drag_keys, const char *bou
              "[dem]\ngravity = 0 0 %g\nsteps_per_contact = 20\n"
              "[coupling]\nfluid = drag\n"
              "[drag]\nviscosity = %g\nfluid_density = %g\n%s",
-             boundary, particles, TC, -G, MU, RHO_F, drag_keys);
+             boundary, particles, TC, gravity_z, MU, RHO_F, drag_keys);
     cfg_t *cfg = cfg_load_string("test.ini", text, 0, NULL);
     assert_non_null(cfg);
     dem_t *d = dem_create_from_config(cfg, MPI_COMM_WORLD);
@@ -189,6 +191,44 @@ static void test_hindered_settling(void **state)
     }
 }
 
+/* fluid_velocity_from = grains: the drag acts on each grain's velocity relative to the mean of the
+ * other grains in its ball, so a suspension translating as a whole (no gravity) keeps its velocity
+ * (to round-off: the mean of equal velocities), where the prescribed fluid at rest stops it as
+ * (1 + Δt/τ)^-k; a lone sphere (no neighbour in its ball) sees fluid_velocity and falls at Stokes's
+ * terminal velocity. */
+static void test_grains_frame(void **state)
+{
+    (void)state;
+    const char *parts = "source = insert\nvolume_fraction = 0.2\nradius = 0.0005\ndensity = 2500\nseed = 3\n"
+                        "velocity = 0.01 0.002 -0.003\n";
+    gravity_z = 0;
+    double worst[2] = {0, 0};
+    for (int q = 0; q < 2; q++) {
+        dem_t *d = make(parts, q ? "fluid_velocity_from = grains\nrotation = false\n" : "rotation = false\n", PERIODIC);
+        assert_int_equal(dem_run_steps(d, 100), DEM_OK);
+        const double U[3] = {0.01, 0.002, -0.003};
+        for (int i = 0; i < dem_count(d); i++) {
+            double v[3];
+            dem_full_velocity(d, i, v);
+            for (int a = 0; a < 3; a++) worst[q] = fmax(worst[q], fabs(v[a] - U[a]) / 0.01);
+        }
+        dem_free(d);
+    }
+    gravity_z = -G;
+    printf("# a translating suspension after 100 steps: largest change %.3g (fluid at rest), %.3g (grains)\n",
+           worst[0], worst[1]);
+    assert_true(worst[1] < 1e-13); /* contacts none: inserted apart, moving together */
+    assert_true(worst[0] > 0.1);   /* the fluid at rest stops it: Δt/τ = 0.15 per step here */
+    /* a lone sphere: Stokes's terminal velocity (ρ_p − ρ_f) g d²/(18μ) */
+    dem_t *d = make("source = list\nparticle1 = center 0.005 0.005 0.005 diameter 0.001 density 2500\n",
+                    "fluid_velocity_from = grains\n", PERIODIC);
+    assert_int_equal(dem_run_steps(d, 8000), DEM_OK); /* 28 relaxation times τ = m/(3πμd) */
+    const double vt = (RHO_P - RHO_F) * G * D * D / (18 * MU), vz = mean_vz(d, 200);
+    printf("# lone sphere with fluid_velocity_from = grains: %.12g v_t\n", vz / -vt);
+    assert_true(fabs(vz / -vt - 1) < 1e-9);
+    dem_free(d);
+}
+
 static void test_restart(void **state)
 {
     (void)state;
@@ -225,6 +265,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_isolated_sphere),
         cmocka_unit_test(test_hindered_settling),
+        cmocka_unit_test(test_grains_frame),
         cmocka_unit_test(test_restart),
     };
     TEST_MPI_RUN("dem_drag", tests);

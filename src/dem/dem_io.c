@@ -299,6 +299,7 @@ void dem_checkpoint_write_loc(dem_t *d, hid_t f)
     if (d->drag.on && d->drag.phi_step >= 0) {
         write_attr_l(f, "drag_fraction_step", d->drag.phi_step);
         write_ds(d, f, "drag_fraction", H5T_NATIVE_DOUBLE, d->drag.phi, d->drag.nphi, 1);
+        if (d->drag.uf_grains) write_ds(d, f, "drag_grain_velocity", H5T_NATIVE_DOUBLE, d->drag.ug, d->drag.nphi, 3);
     }
     /* walls: state and springs */
     for (int w = 0; w < d->nwall; w++) {
@@ -603,8 +604,12 @@ forces:
             d->drag.fd = realloc(d->drag.fd, 3 * ((size_t)nall + 1) * sizeof *d->drag.fd);
             memset(d->drag.phi, 0, ((size_t)nall + 1) * sizeof *d->drag.phi);
             memset(d->drag.fd, 0, 3 * ((size_t)nall + 1) * sizeof *d->drag.fd);
+            d->drag.ug = realloc(d->drag.ug, 3 * ((size_t)nall + 1) * sizeof *d->drag.ug);
+            memset(d->drag.ug, 0, 3 * ((size_t)nall + 1) * sizeof *d->drag.ug);
             d->drag.nphi = nall;
             read_ds(f, "drag_fraction", H5T_NATIVE_DOUBLE, d->drag.phi);
+            if (d->drag.uf_grains && has_ds(f, "drag_grain_velocity"))
+                read_ds(f, "drag_grain_velocity", H5T_NATIVE_DOUBLE, d->drag.ug);
             H5Aread(a, H5T_NATIVE_LONG, &d->drag.phi_step);
             H5Aclose(a);
         }

@@ -72,6 +72,8 @@ typedef struct {
     double n_rz;         /* Richardson–Zaki exponent */
     double mu, rho_f;    /* viscosity, fluid density (buoyancy) */
     double uf[3];        /* prescribed mean fluid velocity */
+    int uf_grains;       /* fluid_velocity_from = grains: U_f of each grain is its neighbours' mean velocity */
+    double *ug;          /* ... by particle id (3 per id), held with φ */
     double radius_rel;   /* sampling radius of φ in mean diameters */
     double R;            /* sampling radius (m), set at the first update */
     int every;           /* DEM steps between updates of φ */

@@ -52,6 +52,10 @@ static const cfg_key_t drag_keys[] = {
      "fluid density (kg/m^3) of the buoyancy -rho_f V g; -1: rho of [fluid]"},
     {"drag", "fluid_velocity", CFG_VEC3, "0 0 0", -1e300, 1e300, NULL,
      "mean velocity U_f of the fluid (m/s), prescribed; the drag acts on the velocity relative to it"},
+    {"drag", "fluid_velocity_from", CFG_ENUM, "prescribed", 1, 0, "prescribed|grains",
+     "the fluid velocity U_f of each grain: prescribed (fluid_velocity) or grains (the mean velocity of the other "
+     "grains in its sampling ball, volume-weighted, fixed grains at rest: the interstitial fluid of a dense bed "
+     "moves with the grains around it; fluid_velocity where the ball holds none)"},
     {"drag", "fraction_radius", CFG_DOUBLE, "3", 0.5, 100, NULL,
      "radius of the sampling ball of the local solid fraction, in mean diameters"},
     {"drag", "fraction_every", CFG_INT, "20", 1, 1000000, NULL,
@@ -67,6 +71,7 @@ void dem_drag_config(dem_t *d, cfg_t *cfg)
     dem_drag_t *D = &d->drag;
     free(D->phi);
     free(D->fd);
+    free(D->ug);
     memset(D, 0, sizeof *D);
     if (fluid_model_of(cfg) != FLUID_MODEL_DRAG) return;
     D->on = 1;
@@ -85,6 +90,7 @@ void dem_drag_config(dem_t *d, cfg_t *cfg)
         D->rho_f = cfg_double(cfg, "fluid", "rho");
     }
     cfg_vec3(cfg, "drag", "fluid_velocity", D->uf);
+    D->uf_grains = cfg_enum(cfg, "drag", "fluid_velocity_from") == 1;
     D->radius_rel = cfg_double(cfg, "drag", "fraction_radius");
     D->every = cfg_int(cfg, "drag", "fraction_every");
     D->rotation = cfg_bool(cfg, "drag", "rotation");
@@ -95,7 +101,8 @@ void dem_drag_free(dem_t *d)
 {
     free(d->drag.phi);
     free(d->drag.fd);
-    d->drag.phi = d->drag.fd = NULL;
+    free(d->drag.ug);
+    d->drag.phi = d->drag.fd = d->drag.ug = NULL;
 }
 
 /* Volume of the intersection of balls of radii R and r whose centres are s apart. */
@@ -175,6 +182,8 @@ static void update_fraction(dem_t *d)
         D->phi = realloc(D->phi, (size_t)d->next_id * sizeof *D->phi);
         D->fd = realloc(D->fd, 3 * (size_t)d->next_id * sizeof *D->fd);
         memset(D->fd, 0, 3 * (size_t)d->next_id * sizeof *D->fd);
+        D->ug = realloc(D->ug, 3 * (size_t)d->next_id * sizeof *D->ug);
+        memset(D->ug, 0, 3 * (size_t)d->next_id * sizeof *D->ug);
         D->nphi = d->next_id;
     }
     for (int i = 0; i < n; i++) {
@@ -194,7 +203,7 @@ static void update_fraction(dem_t *d)
                 if (!dup) off[a][noff[a]++] = k;
             }
         }
-        double vs = 0;
+        double vs = 0, vu[3] = {0, 0, 0};
         for (int qz = 0; qz < noff[2]; qz++)
             for (int qy = 0; qy < noff[1]; qy++)
                 for (int qx = 0; qx < noff[0]; qx++)
@@ -206,11 +215,17 @@ static void update_fraction(dem_t *d)
                             if (d->periodic[a]) dx -= d->L[a] * nearbyint(dx / d->L[a]);
                             s2 += dx * dx;
                         }
-                        if (s2 < reach * reach) vs += lens_volume(R, d->r[j], sqrt(s2));
+                        if (s2 < reach * reach) {
+                            const double lv = lens_volume(R, d->r[j], sqrt(s2));
+                            vs += lv;
+                            if (!d->fixed[j])
+                                for (int a = 0; a < 3; a++) vu[a] += lv * d->v[3 * j + a];
+                        }
                     }
         const double vol = ball_in_box(d, xi, R) - 4.0 / 3.0 * M_PI * d->r[i] * d->r[i] * d->r[i];
         double phi = vol > 0 ? vs / vol : 0.0;
         D->phi[d->id[i]] = phi < 0.95 ? phi : 0.95;
+        for (int a = 0; a < 3; a++) D->ug[3 * d->id[i] + a] = vs > 0 ? vu[a] / vs : D->uf[a];
     }
     free(head);
     free(next);
@@ -233,9 +248,10 @@ void dem_drag_impulses(dem_t *d, double dt)
         const long k = d->id[i];
         const double beta = 6 * M_PI * D->mu * r * hindrance(D, D->phi[k]); /* 3π μ d K */
         const double a = dt * beta / m;                                     /* Δt/τ */
+        const double *uf = D->uf_grains ? D->ug + 3 * k : D->uf;
         for (int c = 0; c < 3; c++) {
             const double fb = -D->rho_f * vol * d->gravity[c];
-            const double vn = (v[3 * i + c] + dt * fb / m + a * D->uf[c]) / (1 + a);
+            const double vn = (v[3 * i + c] + dt * fb / m + a * uf[c]) / (1 + a);
             D->fd[3 * k + c] = m * (vn - v[3 * i + c]) / dt - fb; /* the drag of this step */
             v[3 * i + c] = vn;
         }
