@@ -5,7 +5,7 @@ Every file the runs wrote must be in both folders and identical: HDF5 files
 (snapshots, checkpoints) dataset by dataset and attribute by attribute, bit
 for bit; CSV files line by line (series.csv without its wall_per_step
 column); XDMF indexes, input.ini and the other text files byte for byte;
-summary.json key by key without the entries that measure the machine (wall
+summary.json key by key without the entries that measure the machine (cost, wall
 and CPU times, speeds, memory) or say how the run went (restarted_from,
 steps_this_run).  log.txt, which records how the run went, is not compared.
 The name of the folder (in the resolved input, the summary) is the only
@@ -29,7 +29,7 @@ NOT_COMPARED = {"log.txt", ".ibmdem.lock"}
 # the checkpoints' hash of series.csv covers its wall_per_step column
 ALWAYS_SKIPPED = ("series_hash",)
 # summary.json entries that measure the machine or the way the run went
-MACHINE = ("wall", "per_second", "rss", "restarted_from", "steps_this_run", "time_", "bytes_per")
+MACHINE = ("wall", "per_second", "rss", "restarted_from", "steps_this_run", "time_", "bytes_per", "cost.")
 
 
 RENAME = [None, None]  # folder A's path, read as B's
