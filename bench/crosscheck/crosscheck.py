@@ -526,8 +526,12 @@ def report(out):
                 allruns.append(json.load(open(p)))
     lines, table = [], {}
     names = [n for n in CASES if any(r["case"] == n for r in allruns)]
-    fig, axes = plt.subplots(1, len(names), figsize=(5.2 * len(names), 4.4), squeeze=False)
-    for ax, name in zip(axes[0], names):
+    ncols = min(3, len(names))
+    nrows = (len(names) + ncols - 1) // ncols
+    fig, axes = plt.subplots(nrows, ncols, figsize=(5.2 * ncols, 4.4 * nrows), squeeze=False)
+    for ax in axes.flat[len(names):]:
+        ax.set_visible(False)
+    for ax, name in zip(axes.flat, names):
         cs = CASES[name]
         groups = {}
         for r in allruns:
