@@ -10,8 +10,8 @@
 #                                     sc064_re10, sc064_re50, sc216_stokes, sc343_stokes)
 #   METHODS="calibrated none"         ibmdem's [ibm] radius_correction values
 #   BUILD (default build), OUT (default $BUILD/crosscheck)
-# Cost: 25 min of CPU (43 min wall on the shared 2-core machine) for the five cases, 8 min of CPU
-# for sc064_stokes alone.
+# Cost: 25 min of CPU (43 min wall on the shared 2-core machine) for the five cases, 9 min of CPU
+# (11 min wall) for sc064_stokes alone.
 set -e
 cd "$(dirname "$0")/../.."
 BUILD=${BUILD:-build}
