@@ -167,6 +167,9 @@ def run_ibm(name, n, corr, out):
              balance=fx / (f * L ** 3), cpu=cpu, wall=wall,
              steps=s.get("steps"), t=s.get("time"), status=s.get("status"))
     json.dump(r, open(res, "w"), indent=1)
+    for x in os.listdir(os.path.join(d, "out")):  # the final checkpoint: up to 50 MB, not needed
+        if x.startswith("checkpoint_"):
+            os.remove(os.path.join(d, "out", x))
     return r
 
 
