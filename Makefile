@@ -47,7 +47,7 @@ BIN     := $(BUILD)/ibmdem
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 BENCHES := $(patsubst bench/%.c,$(BUILD)/bench/%,$(wildcard bench/bench_*.c))
 
-.PHONY: all test demo validate bench deps clean restitution viscous_stability bounce fuzz avalanche avalanche_production
+.PHONY: all test demo validate bench deps clean restitution viscous_stability bounce fuzz avalanche avalanche_production crosscheck
 all: $(BIN) $(TESTS) $(BENCHES)
 
 $(BUILD)/obj/%.o: src/%.c
@@ -102,6 +102,12 @@ validate: deps
 bench: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bash bench/run.sh
+
+# ibmdem against OpenFOAM (installed from Debian if missing) on the simple cubic array:
+# build/crosscheck/{table.md,speed_error.png} (bench/crosscheck/run.sh: CASES, METHODS)
+crosscheck: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	@BUILD=$(BUILD) bash bench/crosscheck/run.sh
 
 # restitution curves of the bouncing sphere and the binary collision: the sweep in
 # parallel on the available cores, build/restitution/{restitution,binary}.{csv,png}, target checks

@@ -156,6 +156,9 @@ void fluid_step(fluid_t *f, double dt);
 double fluid_kinetic_energy(const fluid_t *f);
 /* max |D u| over the cells (1/s; D is the divergence of the projection). */
 double fluid_max_divergence(const fluid_t *f);
+/* Volume-weighted mean of velocity component c over the box (all ranks): along
+ * a periodic direction, the flux per unit cross-section (superficial velocity). */
+double fluid_mean_velocity(const fluid_t *f, int c);
 
 /* The discrete operators, for the tests and for other modules.  u must have
  * valid ghosts (fluid_apply_bc); each writes the unknowns of out[c] only.

@@ -17,7 +17,7 @@ report $ok "the folder has input.ini log.txt series.csv summary.json fields.xmf 
 $BIN check $O/input.ini >/dev/null 2>$T/err
 report $? "the resolved input input.ini is itself a valid case file"
 
-[ "$(head -1 $O/series.csv)" = "step,time,dt,cfl,kinetic_energy,div_max,poisson_residual,poisson_iterations,wall_per_step" ]
+[ "$(head -1 $O/series.csv)" = "step,time,dt,cfl,kinetic_energy,div_max,poisson_residual,poisson_iterations,superficial_u,flux_x,superficial_v,flux_y,wall_per_step" ]
 report $? "series.csv has the documented columns"
 $PY - $O <<'PY'
 import csv, json, sys

@@ -10,6 +10,8 @@
 #include "sim.h"
 #include "util.h"
 
+enum { FLUID_NCOL = 5, FLUID_NCOL_MAX = FLUID_NCOL + 7 };
+
 typedef struct {
     sim_t *sim;
     grid_t *g;
@@ -28,10 +30,34 @@ typedef struct {
     io_snapshots_t *snaps;
     int snap_first;       /* index of the first snapshot of this run */
     int viscous_reports;  /* viscous = auto: log lines about its choice */
+    int nper, per[3];     /* the periodic directions */
+    double re_length;     /* [fluid] reynolds_length (0: no Reynolds number) */
+    const char *cols[FLUID_NCOL_MAX];
 } fluid_part_t;
 
-static const char *const fluid_cols[] = {"cfl", "kinetic_energy", "div_max", "poisson_residual",
-                                         "poisson_iterations"};
+static const char *const fluid_cols[FLUID_NCOL] = {"cfl", "kinetic_energy", "div_max", "poisson_residual",
+                                                   "poisson_iterations"};
+static const char *const superficial_cols[3] = {"superficial_u", "superficial_v", "superficial_w"};
+static const char *const flux_cols[3] = {"flux_x", "flux_y", "flux_z"};
+
+/* The periodic flow (docs/user-guide.md): along each periodic direction d the
+ * superficial velocity U_d (the box mean of u_d) and the flux U_d V/L_d through
+ * a cross-section; Re = |U| ℓ/ν.  Returns the number of values (the columns
+ * after fluid_cols). */
+static int periodic_flow(const fluid_part_t *fp, double *c)
+{
+    int n = 0;
+    double u2 = 0.0;
+    for (int m = 0; m < fp->nper; m++) {
+        int d = fp->per[m];
+        double U = fluid_mean_velocity(fp->f, d);
+        c[n++] = U;
+        c[n++] = U * fp->volume / fp->g->L[d];
+        u2 += U * U;
+    }
+    if (fp->nper && fp->re_length > 0) c[n++] = sqrt(u2) * fp->re_length / fp->f->prm.nu;
+    return n;
+}
 
 static int ncomp(const fluid_part_t *fp) { return fp->g->dim == 3 ? 3 : 2; }
 
@@ -72,6 +98,7 @@ static void part_diagnostics(void *ctx, double *c)
 {
     fluid_part_t *fp = ctx;
     const fluid_diag_t *d = &fp->f->diag;
+    periodic_flow(fp, c + FLUID_NCOL);
     if (!fp->stepped) { /* the initial state (or the one restarted from) */
         c[0] = 0;
         c[1] = fp->ke_now;
@@ -324,6 +351,16 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
     io_summary_string(y, KEY("viscous"), visc[fp->f->prm.implicit_viscous]);
     io_summary_long(y, KEY("implicit_steps"), fp->f->implicit_steps);
     if (isfinite(fp->f->dt_viscous)) io_summary_double(y, KEY("explicit_viscous_limit"), fp->f->dt_viscous);
+    double pf[7];
+    int npf = periodic_flow(fp, pf);
+    for (int m = 0; m < fp->nper; m++) {
+        int dd = fp->per[m];
+        char name[40];
+        snprintf(name, sizeof name, "superficial_velocity_%c", "xyz"[dd]);
+        io_summary_double(y, KEY(name), pf[2 * m]);
+        io_summary_double(y, KEY(flux_cols[dd]), pf[2 * m + 1]);
+    }
+    if (npf > 2 * fp->nper) io_summary_double(y, KEY("reynolds"), pf[npf - 1]);
 #undef KEY
 }
 
@@ -357,13 +394,26 @@ void sim_add_fluid(sim_t *s, cfg_t *cfg)
     fp->hmin = grid_min_spacing(g);
     fp->volume = g->geom == GEOM_AXI ? M_PI * g->L[0] * g->L[0] * g->L[1] : g->L[0] * g->L[1] * (g->dim == 3 ? g->L[2] : 1.0);
     s->fluid = fp->f;
+    int ncol = FLUID_NCOL;
+    for (int c = 0; c < FLUID_NCOL; c++) fp->cols[c] = fluid_cols[c];
+    for (int d = 0; d < g->dim; d++)
+        if (g->periodic[d]) {
+            fp->per[fp->nper++] = d;
+            fp->cols[ncol++] = superficial_cols[d];
+            fp->cols[ncol++] = flux_cols[d];
+        }
+    fp->re_length = cfg_double(cfg, "fluid", "reynolds_length");
+    if (fp->re_length > 0 && !fp->nper)
+        cfg_fail(cfg, "fluid", "reynolds_length", "the Reynolds number is that of a flow periodic in some direction: "
+                                                  "this domain has no periodic direction");
+    if (fp->nper && fp->re_length > 0) fp->cols[ncol++] = "reynolds";
     sim_part_t part = {
         .name = "fluid",
         .ctx = fp,
         .stable_dt = part_stable_dt,
         .advance = part_advance,
-        .ncol = 5,
-        .col_names = fluid_cols,
+        .ncol = ncol,
+        .col_names = fp->cols,
         .diagnostics = part_diagnostics,
         .diverged = part_diverged,
         .keep_previous = part_keep_previous,

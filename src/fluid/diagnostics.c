@@ -261,6 +261,31 @@ double fluid_kinetic_energy(const fluid_t *f)
     return g->geom == GEOM_AXI ? 2.0 * M_PI * e : e;
 }
 
+/* The mean of velocity component c over the box, weighted by the control
+ * volumes of its unknowns (all ranks).  Along a periodic direction c it is the
+ * flux through any cross-section normal to c per unit area (discrete
+ * continuity: every cross-section carries the same flux): the superficial
+ * velocity of a periodic flow, solid included. */
+double fluid_mean_velocity(const fluid_t *f, int c)
+{
+    const grid_t *g = f->g;
+    int iend = fluid_iend(g, c), nj = fluid_nu(g, c, 1), nk = fluid_nu(g, c, 2);
+    double sum = 0.0, vol = 0.0;
+    for (int i = 0; i < iend; i++) {
+        double s = 0.0;
+        for (int j = 0; j < nj; j++) {
+            const double *r = f->u[c] + G_IDX(g, i, j, 0);
+            for (int k = 0; k < nk; k++) s += r[k];
+        }
+        double v = fluid_cell_volume(f, c, i);
+        sum += v * s;
+        vol += v * nj * nk;
+    }
+    sum = grid_sum(g, sum);
+    vol = grid_sum(g, vol);
+    return vol > 0 ? sum / vol : 0.0;
+}
+
 /* One sweep over the cells for the divergence and the convective rate (and,
  * unless the last projection gave them, one per component for the energy and
  * max |u|), two reductions. */

@@ -42,6 +42,10 @@ static const cfg_key_t fluid_keys[] = {
      "laminar (exact Couette–Poiseuille profile between the walls of the one wall-bounded direction, or "
      "Hagen–Poiseuille in an axisymmetric pipe)"},
     {"fluid", "init_velocity", CFG_DOUBLE, "1", -1e300, 1e300, NULL, "amplitude U of init = taylor_green"},
+    {"fluid", "reynolds_length", CFG_DOUBLE, "0", 0, 1e300, NULL,
+     "length ℓ of the Reynolds number Re = |U| ℓ/ν of a flow periodic in some direction, U the superficial "
+     "velocity (the box mean of u, solid included) along the periodic directions: column reynolds of series.csv "
+     "and fluid.reynolds of summary.json; 0: none"},
     {"fluid", "init_abc", CFG_VEC3, "1 1 1", -1e300, 1e300, NULL, "coefficients A B C of init = abc"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL}};
 
