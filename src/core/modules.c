@@ -24,4 +24,5 @@ void modules_register_keys(void)
     sim_coupling_register_keys();
     fluid_model_register_keys();
     sim_oedometer_register_keys();
+    sim_probes_register_keys();
 }
