@@ -431,6 +431,14 @@ void dem_config_particles(dem_t *d, cfg_t *cfg)
         if (H5Aexists(f, "time") <= 0) cfg_fail(cfg, "particles", "file", "%s: no attribute time", path);
         H5Fclose(f);
         dem_read_checkpoint(d, path);
+        /* a new run starts its clock at 0 (a restart reads its checkpoint's
+         * own DEM state, not this file): a file written at t > 0, e.g. the
+         * last particle snapshot of a settling run, is the state at t = 0 */
+        if (dem_time(d) != 0) {
+            msg("dem: %s holds the particles at t = %g s: they are the state at t = 0 of this run\n", path,
+                dem_time(d));
+            dem_set_time(d, 0.0);
+        }
     } else if (source == 3) {
         double blo[3], bhi[3];
         dem_read_lammps_data(d, cfg, cfg_string(cfg, "particles", "file"), blo, bhi, 0);
