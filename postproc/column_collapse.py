@@ -24,8 +24,8 @@ Definitions:
   T_visq  eta/(Delta rho g H0); t also in sqrt(D/g)
   front   (x_front - R0)/R0 with x_front the 99th percentile of the x of the mobile grains plus
           their mean radius, at each particle snapshot
-  E_cx    sum of m_i u_i^2/2 over the mobile grains / N, over m g D, at each particle snapshot
-          (its maximum is sampled at the snapshots only: fields_every sets the sampling)
+  E_cx    sum of m_i u_i^2/2 over the mobile grains / N, over m g D: at every series row from the
+          column dem_kinetic_energy_x, else at each particle snapshot
 """
 import configparser
 import glob
@@ -111,6 +111,8 @@ def main():
         fronts.append((ts, (np.percentile(xs[mm, 0], 99) + rs[mm].mean() - R0) / R0))
         ms = rps[mm] * 4 / 3 * np.pi * rs[mm]**3
         ecx.append((ts, float((0.5 * ms * vs[mm, 0]**2).sum() / mm.sum() / (m * G * D))))
+    if "dem_kinetic_energy_x" in s.dtype.names:  # every series row (the DEM's column)
+        ecx = [(float(a), float(b / mob.sum() / (m * G * D))) for a, b in zip(t, s["dem_kinetic_energy_x"])]
     ie = int(np.argmax([e for _, e in ecx]))
     out = {
         "grains": int(mob.sum()), "D": D, "H0": H0, "H0_over_D": H0 / D, "R0_over_D": R0 / D, "a": H0 / R0,
@@ -122,7 +124,7 @@ def main():
         "pb_series": [[float(a), float(b / scale)] for a, b in zip(t[::max(1, len(t) // 200)],
                                                                    ps[::max(1, len(t) // 200)])],
         "front": fronts, "front_final": fronts[-1][1], "Ecx_max": ecx[ie][1], "t_Ecx_max": ecx[ie][0],
-        "Ecx": ecx,
+        "Ecx": ecx[::max(1, len(ecx) // 200)],
     }
     with open(os.path.join(d, "column.json"), "w") as f:
         json.dump(out, f, indent=1)
