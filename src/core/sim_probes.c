@@ -73,7 +73,7 @@ static void part_destroy(void *ctx)
 
 void sim_add_probes(sim_t *s, cfg_t *cfg)
 {
-    if (!s->fluid) cfg_fail(cfg, "probes", "point1", "probes read the resolved fluid: the scene has none");
+    if (!s->fluid) die("probes: the scene has no resolved fluid");
     const grid_t *g = s->fluid->g;
     double pts[3 * (PROBES_MAX + 1)];
     int key_of[PROBES_MAX + 1], n = 0;

@@ -3,7 +3,8 @@
  *
  *   resolved     fluid; with particles: DEM (driven), immersed spheres of the
  *                particles (after those of [ibm]), coupling; without: [ibm] if given;
- *                then the probes of [probes]
+ *                then the probes of [probes] (not read by the other models: the
+ *                log notes their keys as unused)
  *   porenet      DEM (if particles), pore network
  *   drag,
  *   lubrication,
@@ -43,9 +44,6 @@ void sim_build_scene(sim_t *s, cfg_t *cfg)
      * error only when the case did not name its model (it has no [fluid]) */
     if (cfg_has_section(cfg, "ibm") && cfg_enum(cfg, "coupling", "fluid") == 0)
         cfg_fail(cfg, "ibm", "sphere1", "an immersed boundary needs a fluid: the case has no [fluid] section");
-    if (cfg_has_section(cfg, "probes"))
-        cfg_fail(cfg, "probes", "point1", "probes read the resolved fluid: coupling.fluid = %s has none",
-                 cfg_string(cfg, "coupling", "fluid"));
     if (particles) sim_add_dem(s, cfg);
     if (model == FLUID_MODEL_PORENET) sim_add_porenet(s, cfg);
     if (model == FLUID_MODEL_PORENET && cfg_has_section(cfg, "oedometer")) sim_add_oedometer(s, cfg);
