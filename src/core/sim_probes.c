@@ -78,7 +78,7 @@ void sim_add_probes(sim_t *s, cfg_t *cfg)
     double pts[3 * (PROBES_MAX + 1)];
     int key_of[PROBES_MAX + 1], n = 0;
     for (int k = 1; k <= PROBES_MAX; k++) {
-        char key[16];
+        char key[32];
         snprintf(key, sizeof key, "point%d", k);
         if (!cfg_has(cfg, "probes", key)) continue;
         cfg_vec3(cfg, "probes", key, pts + 3 * n);
@@ -96,7 +96,7 @@ void sim_add_probes(sim_t *s, cfg_t *cfg)
     int bad = -1;
     pp->pr = probes_create(g, npt, pts, &bad);
     if (!pp->pr) {
-        char key[16];
+        char key[32];
         if (bad < n) snprintf(key, sizeof key, "point%d", key_of[bad]);
         else snprintf(key, sizeof key, "reference");
         const double *q = pts + 3 * bad;
