@@ -44,6 +44,7 @@ typedef struct {
     long step;
     long n_particles, n_mobile;
     double ke_trans, ke_rot;   /* Σ ½ m v², Σ ½ I ω² of the mobile particles (J) */
+    double ke_axis[3];         /* Σ ½ m v_a² of the mobile particles, per axis a (J) */
     double e_elastic;          /* energy stored in the contact springs (J) */
     long n_contacts;           /* particle–particle contacts (overlapping pairs) */
     long n_wall_contacts;

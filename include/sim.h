@@ -31,7 +31,7 @@
 #include "porenet.h"
 
 #define SIM_MAX_PARTS 8
-#define SIM_MAX_COLS 128
+#define SIM_MAX_COLS 160
 
 typedef struct sim sim_t;
 
@@ -233,6 +233,10 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm);
 void sim_avalanche_register_keys(void);
 void sim_add_avalanche(sim_t *s, cfg_t *cfg, struct ibm *ibm);
 void sim_coupling_register_keys(void);
+/* Pressure probes ([probes], sim_probes.c): columns of series.csv, added
+ * after the other parts of a scene with the resolved fluid. */
+void sim_add_probes(sim_t *s, cfg_t *cfg);
+void sim_probes_register_keys(void);
 /* The scene's fluid model is the resolved fluid ([coupling] fluid, fluid_model.h). */
 int sim_fluid_enabled(cfg_t *cfg);
 

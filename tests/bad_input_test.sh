@@ -151,4 +151,15 @@ grep -q "reached max_steps at step 3" "$T/out"
 report $? "the restarted run advanced to step 3"
 
 chmod 600 "$T/noperm.ini"
+# particles from a file that do not fit the scene: bad input before anything is built
+C=cases/column_collapse/coarse_loose.ini
+l=$(grep -n '^file = ' $C | cut -d: -f1)
+check "particles of a file: periodic length below twice the largest diameter" 2 \
+    "^$C:$l: particles.file: .*needs a periodic length in y of at least twice its diameter" -- \
+    $BIN check $C --set "domain.length=0.304 0.02 0.152"
+check "particles of a file: a centre outside the domain" 2 "^$C:$l: particles.file: .*is outside the domain in x" -- \
+    $BIN check $C --set "domain.length=0.1 0.03648 0.152" --set domain.nx=40 --set "walls.wall1_point=0.09 0 0" \
+    --set "probes.point1=0.05 0.01 0.01" --set "probes.point2=0.05 0.01 0.01" --set "probes.point3=0.05 0.01 0.01" \
+    --set "probes.point4=0.05 0.01 0.01" --set "probes.reference=0.05 0.01 0.1"
+
 tap_end "$T"

@@ -25,4 +25,5 @@ void modules_register_keys(void)
     fluid_model_register_keys();
     sim_oedometer_register_keys();
     sim_avalanche_register_keys();
+    sim_probes_register_keys();
 }

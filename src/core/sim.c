@@ -293,11 +293,11 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
     names[nc++] = "step";
     names[nc++] = "time";
     names[nc++] = "dt";
-    for (int i = 0; i < s->npart; i++) {
-        if (nc + s->part[i].ncol > SIM_MAX_COLS - 1)
-            die("series.csv: more than %d columns (SIM_MAX_COLS) with the part %s", SIM_MAX_COLS, s->part[i].name);
+    int ncol = 4;
+    for (int i = 0; i < s->npart; i++) ncol += s->part[i].ncol;
+    if (ncol > SIM_MAX_COLS) die("series.csv would have %d columns, more than SIM_MAX_COLS = %d", ncol, SIM_MAX_COLS);
+    for (int i = 0; i < s->npart; i++)
         for (int c = 0; c < s->part[i].ncol; c++) names[nc++] = s->part[i].col_names[c];
-    }
     names[nc++] = "wall_per_step";
     char path[IO_PATH_MAX + 16];
     io_outdir_path(&s->out, "series.csv", path, sizeof path);

@@ -36,7 +36,8 @@ typedef struct {
 } dem_part_t;
 
 static const char *const dem_cols[] = {"dem_kinetic_energy", "dem_rotational_energy", "dem_contacts",
-                                       "dem_wall_contacts", "dem_max_overlap"};
+                                       "dem_wall_contacts", "dem_max_overlap", "dem_kinetic_energy_x",
+                                       "dem_kinetic_energy_y", "dem_kinetic_energy_z"};
 
 static void ensure_prepared(dem_part_t *dp)
 {
@@ -82,6 +83,7 @@ static void part_diagnostics(void *ctx, double *c)
     c[2] = (double)g.n_contacts;
     c[3] = (double)g.n_wall_contacts;
     c[4] = g.max_overlap;
+    for (int a = 0; a < 3; a++) c[5 + a] = g.ke_axis[a];
 }
 
 static int part_diverged(void *ctx, char *why, size_t n)
@@ -230,7 +232,7 @@ void sim_add_dem(sim_t *s, cfg_t *cfg)
         .ctx = dp,
         .stable_dt = part_stable_dt,
         .advance = part_advance,
-        .ncol = 5,
+        .ncol = 8,
         .col_names = dem_cols,
         .diagnostics = part_diagnostics,
         .diverged = part_diverged,

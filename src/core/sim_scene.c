@@ -2,7 +2,9 @@
  * fluid_model.h), and the note of the keys a run did not use.
  *
  *   resolved     fluid; with particles: DEM (driven), immersed spheres of the
- *                particles (after those of [ibm]), coupling; without: [ibm] if given
+ *                particles (after those of [ibm]), coupling; without: [ibm] if given;
+ *                then the probes of [probes] (not read by the other models: the
+ *                log notes their keys as unused)
  *   porenet      DEM (if particles), pore network
  *   drag,
  *   lubrication,
@@ -36,6 +38,7 @@ void sim_build_scene(sim_t *s, cfg_t *cfg)
         } else if (cfg_has_section(cfg, "ibm")) {
             sim_add_ibm(s, cfg);
         }
+        if (cfg_has_section(cfg, "probes")) sim_add_probes(s, cfg);
         return;
     }
     /* without the resolved fluid, [ibm] is a section of another model: an

@@ -742,6 +742,7 @@ void dem_diag_light(dem_t *d, dem_diag_t *o)
             v2 += d->v[3 * i + a] * d->v[3 * i + a];
             w2 += d->w[3 * i + a] * d->w[3 * i + a];
             o->momentum[a] += m * d->v[3 * i + a];
+            o->ke_axis[a] += 0.5 * m * d->v[3 * i + a] * d->v[3 * i + a];
             o->com[a] += m * d->x[3 * i + a];
         }
         m_tot += m;

@@ -37,7 +37,9 @@ static const cfg_key_t dem_keys[] = {
     {"particles", "source", CFG_ENUM, "none", 1, 0, "none|insert|file|lammps_data|list",
      "where the particles come from: none (added by a program), random insertion, an HDF5 packing or "
      "checkpoint (file), a LAMMPS data file (lammps_data)"},
-    {"particles", "file", CFG_STRING, NULL, 1, 0, NULL, "HDF5 packing/checkpoint or LAMMPS data file to read"},
+    {"particles", "file", CFG_STRING, NULL, 1, 0, NULL,
+     "HDF5 packing, DEM checkpoint or particle snapshot (particles_NNNNNN.h5), or LAMMPS data file to read; its "
+     "particles are the state at t = 0 of the run"},
     {"particles", "count", CFG_INT, "0", 0, 2e9, NULL, "insert: number of particles (or give volume_fraction)"},
     {"particles", "volume_fraction", CFG_DOUBLE, "0", 0, 0.45, NULL,
      "insert: solid volume fraction of the insertion region (random sequential insertion jams near 0.38)"},
@@ -376,6 +378,37 @@ static void config_list_particle(dem_t *d, cfg_t *cfg, const char *key)
     free(buf);
 }
 
+/* The particles of a file must fit the scene (bad input, before the reader
+ * builds anything): finite radii and centres, centres inside the domain
+ * across its walls, periodic lengths of at least twice the largest diameter. */
+static void check_file_particles(const dem_t *d, cfg_t *cfg, hid_t f, const char *path, long np)
+{
+    double *r = malloc(((size_t)np + 1) * sizeof *r), *x = malloc((3 * (size_t)np + 1) * sizeof *x);
+    if (io_h5_read_array(f, "radius", np, r) != np || io_h5_read_array(f, "position", 3 * np, x) != 3 * np)
+        cfg_fail(cfg, "particles", "file", "%s: position and radius must be [n][3] and [n] real arrays", path);
+    double rmax = 0;
+    for (long k = 0; k < np; k++) {
+        if (!(r[k] > 0 && isfinite(r[k])))
+            cfg_fail(cfg, "particles", "file", "%s: particle %ld has the radius %g", path, k, r[k]);
+        rmax = fmax(rmax, r[k]);
+        for (int a = 0; a < 3; a++) {
+            const double c = x[3 * k + a];
+            const int bounded = !d->periodic[a] && !(d->axisymmetric && a != 1);
+            if (!isfinite(c) || (bounded && (c < d->lo[a] || c > d->hi[a])))
+                cfg_fail(cfg, "particles", "file", "%s: particle %ld (centre %g %g %g) is outside the domain in %c [%g, %g]",
+                         path, k, x[3 * k], x[3 * k + 1], x[3 * k + 2], "xyz"[a], d->lo[a], d->hi[a]);
+        }
+    }
+    for (int a = 0; a < 3; a++)
+        if (d->periodic[a] && d->L[a] < 4 * rmax)
+            cfg_fail(cfg, "particles", "file",
+                     "%s: the largest particle (diameter %g m) needs a periodic length in %c of at least twice its "
+                     "diameter (the domain's is %g m)",
+                     path, 2 * rmax, "xyz"[a], d->L[a]);
+    free(r);
+    free(x);
+}
+
 void dem_config_particles(dem_t *d, cfg_t *cfg)
 {
     const int source = cfg_enum(cfg, "particles", "source");
@@ -429,8 +462,17 @@ void dem_config_particles(dem_t *d, cfg_t *cfg)
                 cfg_fail(cfg, "particles", "file", "%s: no dataset %s (a DEM packing or checkpoint has position, "
                          "velocity, omega, radius, density, id, fixed)", path, need[k]);
         if (H5Aexists(f, "time") <= 0) cfg_fail(cfg, "particles", "file", "%s: no attribute time", path);
+        check_file_particles(d, cfg, f, path, np);
         H5Fclose(f);
         dem_read_checkpoint(d, path);
+        /* a new run starts its clock at 0 (a restart reads its checkpoint's
+         * own DEM state, not this file): a file written at t > 0, e.g. the
+         * last particle snapshot of a settling run, is the state at t = 0 */
+        if (dem_time(d) != 0) {
+            msg("dem: %s holds the particles at t = %g s: they are the state at t = 0 of this run\n", path,
+                dem_time(d));
+            dem_set_time(d, 0.0);
+        }
     } else if (source == 3) {
         double blo[3], bhi[3];
         dem_read_lammps_data(d, cfg, cfg_string(cfg, "particles", "file"), blo, bhi, 0);
