@@ -56,7 +56,8 @@ typedef struct {
     double *fluid;          /* per bin: W, W u_i (3), W u_i u_j (xx yy zz xy xz yz)  (10 nbin), W = (1 − α) dV */
     /* the last step's values */
     double now[AV_NCOL];
-    double *work;           /* scratch (grid field of the resolved fluid's α) */
+    double *work;           /* scratch: grid field of the resolved fluid's α */
+    double *scratch;        /* scratch: 10 nbin (a step's slab sums) + 2 nbin (φ and its D average) */
 } avalanche_t;
 
 /* Set the geometry and numbers (rho, eta of the fluid; g the gravity vector

@@ -69,6 +69,7 @@ void avalanche_init(avalanche_t *a, const dem_t *d, int normal_axis, double bed_
     if (a->nbin < 1) a->nbin = 1;
     a->grain = xcalloc(4 * (size_t)a->nbin, sizeof(double));
     a->fluid = xcalloc(10 * (size_t)a->nbin, sizeof(double));
+    a->scratch = xcalloc(12 * (size_t)a->nbin, sizeof(double));
     a->t1 = t1;
     a->t2 = t2;
 }
@@ -78,7 +79,8 @@ void avalanche_free(avalanche_t *a)
     free(a->grain);
     free(a->fluid);
     free(a->work);
-    a->grain = a->fluid = a->work = NULL;
+    free(a->scratch);
+    a->grain = a->fluid = a->work = a->scratch = NULL;
 }
 
 /* The step [t − dt, t] counts in the window when its middle does. */
@@ -114,11 +116,12 @@ static double slab_average(double z, void *ctx)
  * largest value.  The slab average at the bin centres (from the binned
  * profile) brackets the crossing; Brent's method (GSL) finds it on the exact
  * average. */
-static double bed_height(const avalanche_t *a, const dem_t *d, const double *phi)
+static double bed_height(avalanche_t *a, const dem_t *d, const double *phi)
 {
     const int n = a->nbin, w = (int)fmax(1.0, floor(a->D / a->bin + 0.5));
-    double *s = xcalloc((size_t)n, sizeof(double)), smax = 0.0;
+    double *s = a->scratch + 11 * (size_t)n, smax = 0.0;
     for (int k = 0; k < n; k++) {
+        s[k] = 0.0;
         int c = 0;
         for (int q = k - w / 2; q <= k + (w - 1) / 2; q++)
             if (q >= 0 && q < n) {
@@ -134,7 +137,6 @@ static double bed_height(const avalanche_t *a, const dem_t *d, const double *phi
             top = k;
             break;
         }
-    free(s);
     if (top < 0) return 0.0;
     slab_avg_t q = {a, d, 0.5 * smax};
     double lo = (top + 0.5) * a->bin, hi = fmin(lo + a->bin, a->zmax - a->z0);
@@ -162,7 +164,8 @@ void avalanche_sample_grains(avalanche_t *a, dem_t *d, const dem_force_stats_t *
     const double *fl = dem_lubrication_forces(d);
     const unsigned char *fx = dem_fixed(d);
     const long *id = dem_ids(d);
-    double *prof = xcalloc(4 * (size_t)nb, sizeof(double));
+    double *prof = a->scratch; /* V, V u per slab of this step */
+    memset(prof, 0, 4 * (size_t)nb * sizeof(double));
     double vm = 0, vu = 0, st = 0, Fc = 0, Fl = 0, Fhs = 0;
     int nm = 0;
     for (int i = 0; i < n; i++) {
@@ -187,10 +190,9 @@ void avalanche_sample_grains(avalanche_t *a, dem_t *d, const dem_force_stats_t *
         if (Fh) Fhs += norm3(Fh + 3 * id[i]);
         nm++;
     }
-    double *phi = xcalloc((size_t)nb, sizeof(double));
+    double *phi = a->scratch + 10 * (size_t)nb;
     for (int k = 0; k < nb; k++) phi[k] = prof[4 * k] / (a->area * a->bin);
     const double h = bed_height(a, d, phi);
-    free(phi);
     /* global compacity between D/2 and h − D/2 (the fixed grains and the free surface left out) */
     double vin = 0.0;
     const double lo = 0.5 * a->D, hi = h - 0.5 * a->D;
@@ -213,7 +215,6 @@ void avalanche_sample_grains(avalanche_t *a, dem_t *d, const dem_force_stats_t *
         for (int c = 0; c < AV_NCOL; c++) a->scal[c] += dt * now[c];
         for (long q = 0; q < 4L * nb; q++) a->grain[q] += dt * prof[q];
     }
-    free(prof);
 }
 
 void avalanche_sample_fluid(avalanche_t *a, const fluid_t *f, const ibm_t *ibm, double t, double dt)
@@ -226,7 +227,8 @@ void avalanche_sample_fluid(avalanche_t *a, const fluid_t *f, const ibm_t *ibm, 
         ibm_solid_fraction_cell(ibm, a->work);
     else
         memset(a->work, 0, (size_t)g->nalloc * sizeof(double));
-    double *acc = xcalloc(10 * (size_t)nb, sizeof(double));
+    double *acc = a->scratch; /* the slab sums of this step */
+    memset(acc, 0, 10 * (size_t)nb * sizeof(double));
     const long off[3] = {g->sx, g->sy, 1};
     for (int i = 0; i < g->nxl; i++)
         for (int j = 0; j < g->n[1]; j++)
@@ -253,7 +255,6 @@ void avalanche_sample_fluid(avalanche_t *a, const fluid_t *f, const ibm_t *ibm, 
     MPI_Allreduce(MPI_IN_PLACE, acc, 10 * nb, MPI_DOUBLE, MPI_SUM, g->comm);
     a->tw_fluid += dt;
     for (long q = 0; q < 10L * nb; q++) a->fluid[q] += dt * acc[q];
-    free(acc);
 }
 
 double avalanche_mean(const avalanche_t *a, int col) { return a->tw > 0 ? a->scal[col] / a->tw : 0.0; }
