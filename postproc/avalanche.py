@@ -137,7 +137,6 @@ def main():
     fig, ax = plt.subplots(1, 2, figsize=(9, 4.5))
     for run, lab in zip(a.runs, labels):
         prof, D = read_profiles(os.path.join(run, "profiles.csv"))
-        s = json.load(open(os.path.join(run, "summary.json")))["avalanche"]
         ug = math.sqrt(9.81 * D)
         m = merge_diameter(prof, D)
         ax[0].plot([p["Ug"] / ug for p in m], [p["z_over_D"] for p in m], "o-", label=lab)

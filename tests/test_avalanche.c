@@ -123,8 +123,6 @@ static void test_fluid_shear(void **state)
             for (int k = -g->gz; k < g->n[2] + g->gz; k++) f->u[0][G_IDX(g, i, j, k)] = gam * grid_zc(g, k);
     dem_t *d = lattice(0, 0);
     avalanche_t av;
-    init(&av, d, 0.0, 1.0);
-    avalanche_free(&av);
     const double Lw[3] = {L[0], L[1], L[2]}, gv[3] = {9.81 * sin(0.4), 0, -9.81 * cos(0.4)};
     avalanche_init(&av, d, 2, 0.0, L[2], Lw, gv, RHO, ETA, D, 0.0, 1.0); /* one cell per slab */
     avalanche_sample_fluid(&av, f, NULL, 0.25, 0.25);
