@@ -85,15 +85,17 @@ static const cfg_key_t dem_keys[] = {
     USER_WALL_KEYS(1), USER_WALL_KEYS(2), USER_WALL_KEYS(3), USER_WALL_KEYS(4), USER_WALL_KEYS(5),
     USER_WALL_KEYS(6),
     /* [bed] */
-    {"bed", "type", CFG_ENUM, "none", 1, 0, "none|random|hexagonal",
-     "rough bed of fixed half-grains with centres on a plane: random (2-D random insertion) or hexagonal"},
+    {"bed", "type", CFG_ENUM, "none", 1, 0, "none|random|hexagonal|dense",
+     "rough bed of fixed half-grains with centres on a plane: random (2-D random insertion), hexagonal, or dense "
+     "(random discs pushed apart until none overlaps: a disordered monolayer up to coverage ~0.8)"},
     {"bed", "axis", CFG_ENUM, "z", 1, 0, "x|y|z", "normal of the bed plane"},
     {"bed", "position", CFG_DOUBLE, "0", -BIG, BIG, NULL, "coordinate of the bed grains' centres along axis (m)"},
     {"bed", "radius", CFG_DOUBLE, NULL, 1e-12, BIG, NULL, "mean radius of the bed grains (m)"},
     {"bed", "polydispersity", CFG_DOUBLE, "0", 0, 0.9, NULL, "bed radii uniform in [R(1-p), R(1+p)]"},
     {"bed", "coverage", CFG_DOUBLE, "0.5", 0.01, 0.9, NULL,
-     "random: area fraction covered by the grains' equatorial discs (2-D random insertion jams near 0.547)"},
-    {"bed", "seed", CFG_INT, "2", 0, 2147483647, NULL, "random: seed"},
+     "random, dense: area fraction covered by the grains' equatorial discs (random insertion jams near 0.547, "
+     "dense reaches ~0.8)"},
+    {"bed", "seed", CFG_INT, "2", 0, 2147483647, NULL, "random, dense: seed"},
     {"bed", "freeze_below", CFG_DOUBLE, "-1e300", -BIG, BIG, NULL,
      "after the packing preparation, particles with centre below this coordinate along axis become fixed"},
     /* [packing] */
@@ -198,147 +200,6 @@ static void config_walls(dem_t *d, cfg_t *cfg)
         if (push > 0 && mass <= 0) cfg_fail(cfg, "walls", kf, "a load-controlled wall needs a mass (wall%d_mass > 0)", w);
         dem_wall_set_load(d, d->nwall - 1, push, mass);
     }
-}
-
-/* 2-D random (or hexagonal) layer of fixed grains with centres on a plane. */
-void dem_config_bed(dem_t *d, cfg_t *cfg)
-{
-    const int type = cfg_enum(cfg, "bed", "type");
-    if (type == 0) return;
-    const int ax = cfg_enum(cfg, "bed", "axis");
-    const int a1 = (ax + 1) % 3, a2 = (ax + 2) % 3;
-    const double pos = cfg_double(cfg, "bed", "position");
-    const double R = cfg_double(cfg, "bed", "radius");
-    const double poly = cfg_double(cfg, "bed", "polydispersity");
-    const double rho = cfg_double(cfg, "particles", "density");
-    if (pos < d->lo[ax] || pos > d->hi[ax]) cfg_fail(cfg, "bed", "position", "outside the domain");
-    const double L1 = d->L[a1], L2 = d->L[a2];
-    const double v0[3] = {0, 0, 0};
-    /* grains no machine holds (the particle arrays take about 280 bytes a grain) */
-    const double expect = type == 2 ? floor(L1 / (2 * R) + 1e-9) * floor(L2 / (sqrt(3.0) * R) + 1e-9)
-                                    : cfg_double(cfg, "bed", "coverage") * L1 * L2 / (M_PI * R * R);
-    if (expect * 280.0 > physical_memory_bytes())
-        cfg_fail(cfg, "bed", "radius", "a bed of about %.3g grains needs more than the %.3g GB of memory of this machine",
-                 expect, physical_memory_bytes() / 1e9);
-    if (type == 2) {
-        /* hexagonal: rows along a1 with spacing 2R, rows 2R sin 60° apart */
-        const int n1 = (int)floor(L1 / (2 * R) + 1e-9);
-        const int n2 = (int)floor(L2 / (sqrt(3.0) * R) + 1e-9);
-        if (n1 < 1 || n2 < 1) cfg_fail(cfg, "bed", "radius", "larger than the bed plane");
-        const double s1 = L1 / n1, s2 = L2 / n2;
-        for (int j = 0; j < n2; j++)
-            for (int i = 0; i < n1; i++) {
-                double x[3];
-                x[ax] = pos;
-                x[a1] = d->lo[a1] + (i + 0.5 + 0.5 * (j % 2)) * s1;
-                x[a2] = d->lo[a2] + (j + 0.5) * s2;
-                if (x[a1] >= d->hi[a1]) {
-                    if (!d->periodic[a1]) continue;
-                    x[a1] -= L1;
-                }
-                dem_add_particle(d, x, v0, R, rho, 1);
-            }
-        msg("dem: hexagonal bed of %d x %d fixed grains (R = %g m) at %c = %g m\n", n1, n2, R, "xyz"[ax], pos);
-        return;
-    }
-    /* random sequential insertion of discs in the plane until the coverage */
-    const double cover = cfg_double(cfg, "bed", "coverage");
-    dem_rng_t g;
-    dem_rng_seed(&g, (uint64_t)cfg_int(cfg, "bed", "seed") + 7777);
-    const double area = L1 * L2;
-    double covered = 0;
-    int nb = 0, maxcap = 1024;
-    double *c1 = malloc(maxcap * sizeof(double)), *c2 = malloc(maxcap * sizeof(double)),
-           *cr = malloc(maxcap * sizeof(double));
-    /* a grid of cells of at least the largest diameter: a disc can only meet
-     * the discs of its own and the 8 neighbouring cells (every cell when a
-     * direction has fewer than 3) */
-    const int m1 = (int)fmax(1.0, fmin(floor(L1 / (2 * R * (1 + poly))), fmax(1.0, sqrt(expect)))),
-              m2 = (int)fmax(1.0, fmin(floor(L2 / (2 * R * (1 + poly))), fmax(1.0, sqrt(expect))));
-    int *head = malloc((size_t)m1 * m2 * sizeof(int)), *next = malloc(maxcap * sizeof(int));
-    for (long c = 0; c < (long)m1 * m2; c++) head[c] = -1;
-    long fails = 0;
-    while (covered < cover * area) {
-        const double r = R * (1 + poly * (2 * dem_rng_uniform(&g) - 1));
-        int placed = 0;
-        for (int att = 0; att < 20000 && !placed; att++) {
-            double p1 = d->lo[a1] + dem_rng_uniform(&g) * L1, p2 = d->lo[a2] + dem_rng_uniform(&g) * L2;
-            if (!d->periodic[a1] && (p1 < d->lo[a1] + r || p1 > d->hi[a1] - r)) continue;
-            if (!d->periodic[a2] && (p2 < d->lo[a2] + r || p2 > d->hi[a2] - r)) continue;
-            const int q1 = (int)fmin(m1 - 1, floor((p1 - d->lo[a1]) / L1 * m1)),
-                      q2 = (int)fmin(m2 - 1, floor((p2 - d->lo[a2]) / L2 * m2));
-            int ok = 1;
-            for (int o2 = m2 < 3 ? 0 : -1; o2 <= (m2 < 3 ? m2 - 1 : 1) && ok; o2++)
-                for (int o1 = m1 < 3 ? 0 : -1; o1 <= (m1 < 3 ? m1 - 1 : 1) && ok; o1++) {
-                    int k1 = m1 < 3 ? o1 : q1 + o1, k2 = m2 < 3 ? o2 : q2 + o2;
-                    if (k1 < 0 || k1 >= m1) {
-                        if (!d->periodic[a1]) continue;
-                        k1 = (k1 + m1) % m1;
-                    }
-                    if (k2 < 0 || k2 >= m2) {
-                        if (!d->periodic[a2]) continue;
-                        k2 = (k2 + m2) % m2;
-                    }
-                    for (int k = head[(long)k2 * m1 + k1]; k >= 0 && ok; k = next[k]) {
-                        double e1 = p1 - c1[k], e2 = p2 - c2[k];
-                        if (d->periodic[a1]) e1 -= L1 * round(e1 / L1);
-                        if (d->periodic[a2]) e2 -= L2 * round(e2 / L2);
-                        const double rr = r + cr[k];
-                        if (e1 * e1 + e2 * e2 < rr * rr) ok = 0;
-                    }
-                }
-            if (!ok) continue;
-            if (nb == maxcap) {
-                maxcap *= 2;
-                c1 = realloc(c1, maxcap * sizeof(double));
-                c2 = realloc(c2, maxcap * sizeof(double));
-                cr = realloc(cr, maxcap * sizeof(double));
-                next = realloc(next, maxcap * sizeof(int));
-            }
-            c1[nb] = p1;
-            c2[nb] = p2;
-            cr[nb] = r;
-            next[nb] = head[(long)q2 * m1 + q1];
-            head[(long)q2 * m1 + q1] = nb;
-            nb++;
-            covered += M_PI * r * r;
-            placed = 1;
-        }
-        if (!placed && ++fails > 5)
-            cfg_fail(cfg, "bed", "coverage", "random insertion jammed at coverage %.3f (asked %.3f)", covered / area,
-                     cover);
-    }
-    for (int k = 0; k < nb; k++) {
-        double x[3];
-        x[ax] = pos;
-        x[a1] = c1[k];
-        x[a2] = c2[k];
-        dem_add_particle(d, x, v0, cr[k], rho, 1);
-    }
-    free(c1);
-    free(c2);
-    free(cr);
-    free(head);
-    free(next);
-    msg("dem: random bed of %d fixed grains (coverage %.3f) at %c = %g m\n", nb, covered / area, "xyz"[ax], pos);
-}
-
-void dem_freeze_below(dem_t *d, cfg_t *cfg)
-{
-    const double h = cfg_double(cfg, "bed", "freeze_below");
-    if (h <= -1e299) return;
-    const int ax = cfg_enum(cfg, "bed", "axis");
-    dem_sync_velocities(d);
-    int nf = 0;
-    for (int i = 0; i < d->n; i++) {
-        if (d->fixed[i] || d->x[3 * i + ax] >= h) continue;
-        d->fixed[i] = 1;
-        d->invm[i] = d->invI[i] = 0.0;
-        for (int a = 0; a < 3; a++) d->v[3 * i + a] = d->w[3 * i + a] = 0.0;
-        nf++;
-    }
-    d->ready = 0;
-    msg("dem: %d particles below %c = %g m are now fixed (rough bed)\n", nf, "xyz"[ax], h);
 }
 
 /* One particle of source = list: "center X Y Z diameter D density RHO ...". */
