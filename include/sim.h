@@ -89,6 +89,7 @@ typedef struct {
     double cfl_abort;      /* hard CFL limit: above it the run has diverged */
     double ke_growth_abort; /* kinetic energy growing by more than this factor in one step: diverged */
     int rollback;          /* keep the previous state (checkpoint on divergence, steady test) */
+    int step_retries;      /* a diverging step is taken again with half its dt up to this many times */
     char dir[IO_PATH_MAX]; /* output folder */
     char name[256];        /* case name */
     double fields_every;   /* simulated time between field snapshots (0: first and last only) */
@@ -134,6 +135,10 @@ struct sim {
     double time_prev;        /* time, step and dt at the start of the last step */
     long step_prev;
     double dt_prev;
+    double dt_cap;           /* a step taken again after it diverged: at most this dt (0: no cap) */
+    int retries;             /* times the current step has been taken again */
+    int retry_ok;            /* the part that diverged says a smaller step may cure it (set in its diverged()) */
+    long rejected_steps;     /* steps taken again with a smaller dt, since the start (checkpointed) */
     double wall0, wall_step; /* start of the run; wall time of the last step */
     double part_wall[SIM_MAX_PARTS]; /* wall time in each part's advance, this run (summary.json "cost") */
     double output_wall;      /* wall time in the outputs (series, snapshots, checkpoints), this run */

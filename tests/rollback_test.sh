@@ -12,7 +12,12 @@
 #  3. a checkpoint with a NaN in it is refused on restart (exit 1, the dataset named);
 #  4. the divergence advice is a command that works as printed: the run's own --set and --out
 #     (a folder with a space and a quote in its name), shell-quoted, and a smaller step (the
-#     cavity at dt = 0.12 diverges at step 6; the advice's dt = 0.06 runs to the end).
+#     cavity at dt = 0.12 diverges at step 6; the advice's dt = 0.06 runs to the end);
+#  5. a step of an adaptive step that diverges is taken again with half its dt (time.step_retries;
+#     IBMDEM_FAULT=diverge_retry@N: a divergence that the smaller step cures): the run goes on, logs
+#     the retry, counts it in summary.json (rejected_steps = 1), its step N is at most half the
+#     uninterrupted run's; restarted from a checkpoint after the retry, the folder is the faulted
+#     run's (resolved coupling: the bouncing sphere).
 # Prints TAP lines.
 . "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_rollback.XXXXXX)
@@ -77,5 +82,27 @@ echo "# $cmd"
     eval "$cmd" >$T/advice2.log 2>&1 && grep -q "restarted from $A/checkpoint_" $T/advice2.log &&
     grep -q "reached t_end" $T/advice2.log
 report $? "the divergence advice (exit $rc) is a command that works as printed: the run's --set and --out, quoted, and dt = 0.06"
+
+# 5. a diverging adaptive step taken again with half its dt
+N=30
+RT="$BNC $OUT --set time.max_steps=40 --set output.checkpoint_every=4 --set output.checkpoint_keep=0"
+IBMDEM_FAULT=diverge_retry@$N $BIN run $RT --out $T/retry >$T/retry.log 2>&1
+rc=$?
+$BIN run $RT --out $T/retry_plain >$T/retry_plain.log 2>&1
+dts=$($PY -c "
+import csv
+a = {r['step']: float(r['dt']) for r in csv.DictReader(open('$T/retry/series.csv'))}
+b = {r['step']: float(r['dt']) for r in csv.DictReader(open('$T/retry_plain/series.csv'))}
+print(a['$N'], b['$N'])")
+echo "# step $N: dt $dts (retried, plain)"
+# the restart continues in a copy of the faulted run's folder, from the checkpoint after the retry
+cp -r $T/retry $T/retry_copy && rm -f $T/retry_copy/checkpoint_0000003[6-9].h5 $T/retry_copy/checkpoint_00000040.h5
+[ $rc = 0 ] && grep -q "step $N (t = .*) diverged: .*injected.*; taken again with dt <= .* (retry 1 of 4)" $T/retry.log &&
+    grep -q '"rejected_steps": 1,' $T/retry/summary.json &&
+    $PY -c "a, b = map(float, '$dts'.split()); assert a <= 0.5 * b" &&
+    $BIN run $RT --out $T/retry_copy --restart $T/retry_copy/checkpoint_00000032.h5 >$T/retry_re.log 2>&1 &&
+    grep -q '"rejected_steps": 1,' $T/retry_copy/summary.json &&
+    $PY tests/compare_runs.py $T/retry_copy $T/retry
+report $? "a diverging adaptive step (IBMDEM_FAULT=diverge_retry@$N, exit $rc) is taken again with half its dt, logged and counted; a restart after it gives the faulted run's folder"
 
 tap_end "$T"

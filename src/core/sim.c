@@ -26,6 +26,11 @@ static const cfg_key_t sim_keys[] = {
      "hard CFL limit: a step above it (or above twice the CFL target of an adaptive step) means divergence"},
     {"time", "ke_growth_abort", CFG_DOUBLE, "100", 1.000001, 1e300, NULL,
      "kinetic energy growing by more than this factor in one step means divergence"},
+    {"time", "step_retries", CFG_INT, "4", 0, 100, NULL,
+     "a step of an adaptive fluid step that diverges (CFL or kinetic-energy limit, non-finite values) is taken "
+     "again from its start with half its time step, up to this many times, before the run stops as diverged "
+     "(needs rollback; each retry is logged, their count is summary.json's rejected_steps); 0: stop at the first "
+     "divergence"},
     {"time", "rollback", CFG_BOOL, "true", 1, 0, NULL,
      "keep the state at the start of each step, so a diverging run checkpoints its last good state "
      "(costs one copy of the velocity and pressure, of the spheres, of the DEM's particles, springs and lists, "
@@ -50,6 +55,7 @@ void sim_register_keys(void) { cfg_schema_add(sim_keys); }
 
 const char *const sim_run_control_keys[] = {"time.t_end",     "time.max_steps", "time.wall_limit", "time.steady_tol",
                                             "time.cfl_abort", "time.ke_growth_abort", "time.rollback",
+                                            "time.step_retries",
                                             "output.*",       "poisson.fftw_wisdom", NULL};
 
 static void read_params(sim_t *s, cfg_t *cfg)
@@ -62,6 +68,7 @@ static void read_params(sim_t *s, cfg_t *cfg)
     p->cfl_abort = cfg_double(cfg, "time", "cfl_abort");
     p->ke_growth_abort = cfg_double(cfg, "time", "ke_growth_abort");
     p->rollback = cfg_bool(cfg, "time", "rollback");
+    p->step_retries = cfg_int(cfg, "time", "step_retries");
     /* The case name defaults to the file name without its directory and .ini */
     if (cfg_has(cfg, "output", "name")) {
         if (strlen(cfg_string(cfg, "output", "name")) >= sizeof p->name)
@@ -157,6 +164,7 @@ static int write_checkpoint(sim_t *s)
     io_h5_attr_hash(f, "series_hash", io_series_hash(s->series, s->step), s->comm);
     io_h5_attr_long(f, "fields_last_step", s->last_fields_step);
     io_h5_attr_double(f, "last_dt", s->dt);
+    io_h5_attr_long(f, "rejected_steps", s->rejected_steps);
     for (int i = 0; i < s->npart; i++) {
         sim_part_t *p = &s->part[i];
         if (!p->checkpoint_write) continue;
@@ -208,6 +216,7 @@ static void read_checkpoint(sim_t *s, const char *path)
     s->series_resume.has_hash = io_h5_get_attr_hash(f, "series_hash", &s->series_resume.hash) == 0;
     if (io_h5_get_attr_long(f, "fields_last_step", &s->last_fields_step)) s->last_fields_step = -1;
     if (io_h5_get_attr_double(f, "last_dt", &s->dt)) s->dt = 0;
+    if (io_h5_get_attr_long(f, "rejected_steps", &s->rejected_steps)) s->rejected_steps = 0;
     /* the folder's own checkpoint of this step: not written again at the end */
     char own[IO_PATH_MAX + 64];
     snprintf(own, sizeof own, "%s/checkpoint_%08ld.h5", s->out.dir, s->step);
@@ -320,6 +329,7 @@ static double stable_dt(sim_t *s)
             if (!(l > 0)) return l; /* zero, negative or not a number: no step (sim_run stops) */
             dt = fmin(dt, l);
         }
+    if (s->dt_cap > 0) dt = fmin(dt, s->dt_cap); /* a step taken again after it diverged */
     for (int i = 0; i < s->npart; i++)
         if (s->part[i].align_dt) dt = fmin(dt, s->part[i].align_dt(s->part[i].ctx, dt));
     /* Land on t_end: a last step shortened (or slightly stretched, by less
@@ -369,8 +379,15 @@ static int diagnostics(sim_t *s, double *row)
 /* Any part diverged?  The first reason found is kept in s->why. */
 static int diverged(sim_t *s)
 {
+    s->retry_ok = 0;
     if (fault_armed("diverge", s->step)) { /* a test: a divergence at a chosen step */
         snprintf(s->why, sizeof s->why, "%s: divergence injected by IBMDEM_FAULT", s->part[s->npart - 1].name);
+        return 1;
+    }
+    if (fault_armed("diverge_retry", s->step)) { /* a test: one that a smaller step cures */
+        snprintf(s->why, sizeof s->why, "%s: divergence injected by IBMDEM_FAULT (a smaller step cures it)",
+                 s->part[s->npart - 1].name);
+        s->retry_ok = 1;
         return 1;
     }
     for (int i = 0; i < s->npart; i++) {
@@ -491,6 +508,7 @@ static void write_summary(sim_t *s)
     io_summary_long(y, "ranks", mpi_size());
     io_summary_long(y, "steps", s->step);
     io_summary_long(y, "steps_this_run", s->step - s->step0);
+    io_summary_long(y, "rejected_steps", s->rejected_steps);
     io_summary_double(y, "time", s->time);
     io_summary_double(y, "last_dt", s->dt);
     io_summary_double(y, "wall_time", wall);
@@ -551,6 +569,35 @@ static int stop_io_error(sim_t *s)
         snprintf(text + len, sizeof text - len, "  no checkpoint could be written\n");
     }
     report_error(s, text);
+    return 1;
+}
+
+/* The step just taken diverged: can it be taken again with half its time
+ * step?  Only when the part that diverged says a smaller step may cure it (the
+ * fluid with an adaptive step: a CFL number or a kinetic-energy jump beyond
+ * the limits when the grains' velocities changed faster than the step
+ * followed).  Every part brings back its state at the start of the step, the
+ * next time step is capped at half the failed one, and the retry is logged.
+ * A run without rollback, a part that cannot restore its state, a fixed time
+ * step, an injected fault or the last allowed retry stop the run
+ * (stop_diverged). */
+static int retry_step(sim_t *s)
+{
+    if (!s->prm.rollback || !s->retry_ok || s->retries >= s->prm.step_retries) return 0;
+    for (int i = 0; i < s->npart; i++)
+        if (s->part[i].restore_previous == NULL && s->part[i].checkpoint_write != NULL) return 0;
+    const double bad_dt = s->dt;
+    for (int i = 0; i < s->npart; i++)
+        if (s->part[i].restore_previous) s->part[i].restore_previous(s->part[i].ctx);
+    s->time = s->time_prev;
+    s->step = s->step_prev;
+    s->dt = s->dt_prev;
+    s->dt_cap = 0.5 * bad_dt;
+    s->retries++;
+    s->rejected_steps++;
+    io_progress_clear(&s->progress);
+    msg("step %ld (t = %.10g, dt = %.6g) diverged: %s; taken again with dt <= %.6g (retry %d of %d)\n",
+        s->step + 1, s->time, bad_dt, s->why, s->dt_cap, s->retries, s->prm.step_retries);
     return 1;
 }
 
@@ -653,8 +700,14 @@ int sim_run(sim_t *s)
          *    each projected to a divergence-free velocity) */
         advance(s, dt);
         if (s->step == s->step0 + 1) sim_note_unused(s); /* every part has read its keys */
-        /* 3. diagnostics and checks; a diverged run stops with a checkpoint */
-        if (diverged(s)) return stop_diverged(s);
+        /* 3. diagnostics and checks; a diverged step is taken again with half
+         *    its time step (time.step_retries), else the run stops with a checkpoint */
+        if (diverged(s)) {
+            if (retry_step(s)) continue;
+            return stop_diverged(s);
+        }
+        s->dt_cap = 0;
+        s->retries = 0;
         /* 4. the outputs due at this step; a failed write stops the run */
         if (outputs(s)) return stop_io_error(s);
     }

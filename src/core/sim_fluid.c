@@ -128,6 +128,8 @@ static int part_diverged(void *ctx, char *why, size_t n)
     fluid_part_t *fp = ctx;
     const fluid_diag_t *d = &fp->f->diag;
     const sim_params_t *sp = &fp->sim->prm;
+    /* an adaptive step may be taken again with a smaller dt (sim.c, retry_step); a fixed one is the user's */
+    fp->sim->retry_ok = fp->f->prm.dt_fixed <= 0;
     if (!isfinite(fp->ke_now) || !isfinite(d->div_max) || !isfinite(d->res_poisson) || !isfinite(d->cfl)) {
         snprintf(why, n, "non-finite values (kinetic energy %g, max |div u| %g, Poisson residual %g)", fp->ke_now,
                  d->div_max, d->res_poisson);
