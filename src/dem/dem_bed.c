@@ -129,8 +129,9 @@ void dem_config_bed(dem_t *d, cfg_t *cfg)
         /* hexagonal: rows along a1 with spacing 2R, rows 2R sin 60° apart */
         const int n1 = (int)floor(L1 / (2 * R) + 1e-9);
         int n2 = (int)floor(L2 / (sqrt(3.0) * R) + 1e-9);
-        /* across a periodic direction the rows alternate all the way round: an even count */
-        if (d->periodic[a2] && n2 > 1 && n2 % 2) n2--;
+        /* across a periodic direction an odd count puts two unshifted rows side by side at the
+         * seam: they would overlap closer than 2R apart, so the count becomes even */
+        if (d->periodic[a2] && n2 > 1 && n2 % 2 && L2 / n2 < 2 * R) n2--;
         if (n1 < 1 || n2 < 1) cfg_fail(cfg, "bed", "radius", "larger than the bed plane");
         const double s1 = L1 / n1, s2 = L2 / n2;
         for (int j = 0; j < n2; j++)
