@@ -1,20 +1,21 @@
 #!/bin/bash
-# avalanche_test.sh — the quick immersed avalanche (cases/avalanche/coarse.ini: 77 grains, 3 D x 3 D
-# x 12 D, D/dx = 5, soft contacts; docs/theory.md §11), 20 sqrt(D/g) after gravity turns to 25 deg:
+# avalanche_test.sh — the quick immersed avalanche (cases/avalanche/coarse.ini: 77 grains on 3 x 3
+# hexagonal bed grains, 3 D x 3 D x 12 D, D/dx = 5, soft contacts; docs/theory.md §11), 20 sqrt(D/g)
+# after gravity turns to 25 deg (T with the thesis' L = 5 D, avalanche.flow_length):
 #  1. Table 4.3's case 2 (rho_p/rho = 4, St = 0.31, viscous) and case 7 (rho_p/rho = 100,
-#     St = 111, free fall) both run without divergence, overlaps below 2 % of D (measured 0.33 %
-#     and 0.65–0.75 % with these soft contacts);
+#     St = 111, free fall) both run without divergence, overlaps below 2 % of D (measured 0.25 %
+#     and 0.97 % with these soft contacts);
 #  2. the ordering of the regimes: the free-fall bed flows faster (mean Q_g over 9–20 sqrt(D/g)
-#     at least 3x the viscous one; measured 3.9x, and 5.2x in the sanitizer build: the free-fall
-#     run is chaotic, its Q_g moves by ~15 % with round-off), and the lubrication's share of the force
-#     balance (per grain) is at least 10x larger in the viscous run (measured 0.29 against 0.01);
-#     the viscous flow time is set by T_v (T/T_v between 1 and 100, measured 18.4: this short,
-#     narrow run is still accelerating) and the free-fall one is far from it (T/T_v > 100,
-#     measured 1.5e3–2.0e3);
+#     at least 3x the viscous one; measured 26x: the viscous bed has not triggered yet at 20, the
+#     free-fall run is chaotic, its Q_g moves by ~15 % with round-off), and the lubrication's share
+#     of the force balance (per grain) is at least 10x larger in the viscous run (measured 0.17
+#     against 0.011); the viscous flow time is set by T_v (T/T_v between 1 and 100, measured 51:
+#     before the triggering, ~70 in this box) and the free-fall one is far from it (T/T_v > 100,
+#     measured 821);
 #  3. restart = uninterrupted run: the viscous run restarted from a checkpoint in the averaging
 #     window writes the same profiles.csv and series.csv, and the same averages in summary.json.
-# The viscous plateau itself (T/T_v of 0.7–1.5) needs the production box and hundreds of
-# sqrt(D/g): make avalanche.  Prints TAP lines; ~40 s.
+# The viscous plateau itself (T/T_v of 0.7–1.5) needs ~150 sqrt(D/g) after the triggering:
+# make avalanche.  Prints TAP lines; ~40 s.
 . "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_avalanche.XXXXXX)
 Q="--set output.progress=off"

@@ -21,6 +21,9 @@ static const cfg_key_t avalanche_keys[] = {
     {"avalanche", "average_from", CFG_DOUBLE, "0", 0, 1e300, NULL,
      "start of the averaging window of the profiles and means (s)"},
     {"avalanche", "average_to", CFG_DOUBLE, "1e300", 0, 1e300, NULL, "end of the averaging window (s)"},
+    {"avalanche", "flow_length", CFG_DOUBLE, "0", 0, 1e300, NULL,
+     "the length L of the flow time T = L W h_g / Q_g (m; the thesis' eq. 4.12 with its box's L): 0: the "
+     "domain's downslope length; 5 D compares a box of another length with the thesis' production box"},
     {"avalanche", "bin", CFG_DOUBLE, "0", 0, 1e300, NULL,
      "height of the profile slabs (m); 0: a fifth of the mean mobile grain diameter"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
@@ -39,6 +42,7 @@ typedef struct {
     dem_t *d;
     avalanche_t a, prev;
     double bin, t1, t2, zmax, L[3], z0;
+    double flow_length; /* L of the flow time (0: the domain's downslope length) */
     int an;
     double rho, eta;
     double *Fh;        /* hydrodynamic force by particle id (resolved fluid) */
@@ -164,7 +168,10 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
         snprintf(nm, sizeof nm, "mean.%s", av_cols[c]);
         io_summary_double(y, KEY(nm), avalanche_mean(a, c));
     }
-    const double T = avalanche_flow_time(a);
+    /* T = L W h_g / Q_g grows with L (T = L/(phi U)): the box's downslope length, or flow_length */
+    const double Lbox = ap->L[a->as], Lflow = ap->flow_length > 0 ? ap->flow_length : Lbox;
+    const double T = avalanche_flow_time(a) * Lflow / Lbox;
+    io_summary_double(y, KEY("flow_length"), Lflow);
     io_summary_double(y, KEY("T"), a->tw > 0 ? T : NAN);
     io_summary_double(y, KEY("T_over_Tv"), a->tw > 0 ? T / a->Tv : NAN);
     io_summary_double(y, KEY("T_over_Ti"), a->tw > 0 ? T / a->Ti : NAN);
@@ -217,6 +224,7 @@ void sim_add_avalanche(sim_t *s, cfg_t *cfg, struct ibm *ibm)
     ap->t2 = cfg_double(cfg, "avalanche", "average_to");
     if (ap->t2 <= ap->t1) cfg_fail(cfg, "avalanche", "average_to", "must be after average_from (%g s)", ap->t1);
     ap->bin = cfg_double(cfg, "avalanche", "bin");
+    ap->flow_length = cfg_double(cfg, "avalanche", "flow_length");
     /* the bed's normal and plane: those of [bed] (the domain's low face without a bed) */
     double x0[3];
     cfg_vec3(cfg, "domain", "length", ap->L);

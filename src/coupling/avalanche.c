@@ -24,6 +24,17 @@ static double cap_below(double R, double s)
 /* Volume of the sphere (centre c, radius R) between the heights a < b. */
 static double slab_volume(double c, double R, double a, double b) { return cap_below(R, b - c) - cap_below(R, a - c); }
 
+typedef struct {
+    long id;
+    int i;
+} id_index_t;
+
+static int cmp_id(const void *x, const void *y)
+{
+    const long a = ((const id_index_t *)x)->id, b = ((const id_index_t *)y)->id;
+    return (a > b) - (a < b);
+}
+
 void avalanche_init(avalanche_t *a, const dem_t *d, int normal_axis, double bed_plane, double zmax,
                     const double L[3], const double g[3], double rho, double eta, double bin, double t1, double t2)
 {
@@ -41,16 +52,23 @@ void avalanche_init(avalanche_t *a, const dem_t *d, int normal_axis, double bed_
     a->area = L[as] * L[at];
     a->g = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
     a->sin_theta = a->g > 0 ? fabs(g[as]) / a->g : 0.0;
-    /* the mean mobile grain */
+    /* the mean mobile grain, summed in the order of the ids: the DEM reorders its
+     * particles, and a restart must find the same D to the last bit */
     const unsigned char *fx = dem_fixed(d);
     const double *r = dem_radii(d);
+    const int n = dem_count(d);
+    id_index_t *o = xcalloc((size_t)n + 1, sizeof *o);
+    for (int i = 0; i < n; i++) o[i] = (id_index_t){dem_ids(d)[i], i};
+    qsort(o, (size_t)n, sizeof *o, cmp_id);
     int nm = 0;
-    for (int i = 0; i < dem_count(d); i++) {
+    for (int k = 0; k < n; k++) {
+        const int i = o[k].i;
         if (fx[i]) continue;
         a->D += 2 * r[i];
         a->rho_p += dem_density(d, i);
         nm++;
     }
+    free(o);
     if (nm) {
         a->D /= nm;
         a->rho_p /= nm;
