@@ -4,12 +4,13 @@
 #   map         the regime map: rho_p/rho in {2.7, 4, 10, 40, 100} x St in {0.05, 0.3, 1, 4.5, 20, 100}
 #               (30 runs) and the seven cases of Table 4.3, in the quick box (coarse.ini: 3 D x 3 D,
 #               D/dx = 5, soft contacts) to 300 sqrt(D/g), averaged from 150 sqrt(D/g)
+#   table       the seven cases of Table 4.3 alone, in the quick box as for map
 #   production  the seven cases of Table 4.3 in the production box (case.ini: 5 D x 5 D x 20 D,
 #               D/dx = 10, the thesis' contacts) to 300 sqrt(D/g), averaged from 200 sqrt(D/g)
 # Runs two at a time; each run's folder, then OUT/<set>.md (the table with regime labels by the
 # thesis' method) and OUT/<set>_map.png, OUT/<set>_profiles.png, OUT/<set>_series.png.
 set -u
-OUT=${1:?usage: avalanche.sh OUT [map|production|all]}
+OUT=${1:?usage: avalanche.sh OUT [map|table|production|all]}
 WHAT=${2:-map}
 cd "$(dirname "$0")/.."
 BUILD=${BUILD:-build}
@@ -42,6 +43,8 @@ map | all)
     grid=""
     for r in 2.7 4 10 40 100; do for s in 0.05 0.3 1 4.5 20 100; do grid="$grid $r:$s"; done; done
     run_set map cases/avalanche/coarse.ini 300 150 "$table43$grid" ;;&
+table)
+    run_set table cases/avalanche/coarse.ini 300 150 "$table43" ;;
 production | all)
     run_set production cases/avalanche/case.ini 300 200 "$table43" ;;
 esac
