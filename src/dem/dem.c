@@ -141,6 +141,7 @@ void dem_free(dem_t *d)
                    d->r, d->invm, d->invI, d->rho, d->id, d->fixed};
     for (size_t a = 0; a < sizeof arr / sizeof arr[0]; a++) free(arr[a]);
     free(d->kernel_block);
+    dem_lubrication_free(d);
     for (int q = 0; q < DEM_MAX_THREADS; q++) {
         free(d->tblock[q]);
         free(d->tforce[q]);
