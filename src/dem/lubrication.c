@@ -31,7 +31,8 @@
  * after the impulse): a scalar equation per pair,
  *     m* (u′ − u) + k [L(δ₀) − L(δ₀ − Δt u′)] = 0,
  * whose left side increases strictly with u′, so it has one root, found by
- * safeguarded Newton iterations in a bracket (lub_solve).  The scheme is
+ * safeguarded Newton iterations in a bracket (lub_solve), or, when the drift
+ * is small against the film, by the series of lub_drift_coef.  The scheme is
  * implicit (unconditionally stable: a pair can never be pushed through
  * δ = −η_e by its own lubrication, whatever η_e/R and Δt), and for a lone
  * pair it keeps u − (k/m*) L(δ) constant exactly, the first integral of the
@@ -39,6 +40,8 @@
  * Pairs sharing a particle are solved one after the other in list order
  * (a Gauss–Seidel sweep, deterministic): each solve minimises a convex
  * function of the velocities, so the sweep is dissipative and stable.  The
+ * sweep first gathers the pairs it may lubricate and their constants
+ * (lub_gather_pairs), then runs the chain of solves.  The
  * force reported for output is the impulse divided by Δt.
  *
  * The lists must hold every pair within Δ_lub: the skin is widened by the
@@ -115,28 +118,45 @@ typedef struct {
     double d[7];     /* d₀ … d₆ */
 } lub_drift_t;
 
+/* The coefficients d₀ … d₆ times `scale` (1, or m* for the impulse) of a
+ * pair of mass m, k Δt = kd, 1/a = ia, 1/(Δ_lub + η_e) or 0 = sub; returns
+ * the bound of |Δt u/a| below which the series holds, 1e-3/max(1, β).
+ * Without branches (the sweep's constants are computed by a vectorised loop). */
+static inline double lub_series(double m, double kd, double ia, double sub, double dt, double scale, double d[7])
+{
+    const double iM = 1.0 / (m + kd * (ia - sub));
+    const double b = kd * ia * iM, g = dt * m * iM * ia, mM = scale * m * iM;
+    const double c2 = -0.5 * b, c3 = b * (0.5 * b - 1.0 / 3.0), c4 = b * (b * (5.0 / 6.0 - 0.625 * b) - 0.25);
+    const double c5 = b * (b * (b * (0.875 * b - 1.75) + 13.0 / 12.0) - 0.2);
+    const double c6 = b * (b * (b * (b * (3.5 - 1.3125 * b) - 119.0 / 36.0) + 77.0 / 60.0) - 1.0 / 6.0);
+    const double c7 = b * (b * (b * (b * (b * (2.0625 * b - 6.875) + 8.75) - 236.0 / 45.0) + 29.0 / 20.0) - 1.0 / 7.0);
+    const double g2 = g * g, g3 = g2 * g, g4 = g2 * g2;
+    d[0] = -scale * kd * (ia - sub) * iM;
+    d[1] = mM * c2 * g;
+    d[2] = mM * c3 * g2;
+    d[3] = mM * c4 * g3;
+    d[4] = mM * c5 * g4;
+    d[5] = mM * c6 * g4 * g;
+    d[6] = mM * c7 * g3 * g3;
+    return 1e-3 / (b > 1.0 ? b : 1.0);
+}
+
+/* u (d₀ + d₁ u + … + d₆ u⁶), in a short chain of operations. */
+static inline double lub_series_eval(double u, double d0, double d1, double d2, double d3, double d4, double d5,
+                                     double d6)
+{
+    const double u2 = u * u;
+    return u * ((d0 + d1 * u) + u2 * (d2 + d3 * u) + u2 * u2 * ((d4 + d5 * u) + u2 * d6));
+}
+
 static inline void lub_drift_coef(const lub_pair_t *p, double m, double k, double dt, double gap0, lub_drift_t *c)
 {
     if (!(gap0 > 0 && gap0 < p->range)) {
         c->ia = 0.0;
         return;
     }
-    const double kd = k * dt, ia = 1.0 / (gap0 + p->eta), iM = 1.0 / (m + kd * (ia - p->sub));
-    const double b = kd * ia * iM, g = dt * m * iM * ia, mM = m * iM;
-    c->ia = ia;
-    c->zmax = 1e-3 / fmax(1.0, b);
-    c->d[0] = -kd * (ia - p->sub) * iM;
-    const double c2 = -0.5 * b, c3 = b * (0.5 * b - 1.0 / 3.0), c4 = b * (b * (5.0 / 6.0 - 0.625 * b) - 0.25);
-    const double c5 = b * (b * (b * (0.875 * b - 1.75) + 13.0 / 12.0) - 0.2);
-    const double c6 = b * (b * (b * (b * (3.5 - 1.3125 * b) - 119.0 / 36.0) + 77.0 / 60.0) - 1.0 / 6.0);
-    const double c7 = b * (b * (b * (b * (b * (2.0625 * b - 6.875) + 8.75) - 236.0 / 45.0) + 29.0 / 20.0) - 1.0 / 7.0);
-    const double g2 = g * g, g3 = g2 * g, g4 = g2 * g2;
-    c->d[1] = mM * c2 * g;
-    c->d[2] = mM * c3 * g2;
-    c->d[3] = mM * c4 * g3;
-    c->d[4] = mM * c5 * g4;
-    c->d[5] = mM * c6 * g4 * g;
-    c->d[6] = mM * c7 * g3 * g3;
+    c->ia = 1.0 / (gap0 + p->eta);
+    c->zmax = lub_series(m, k * dt, c->ia, p->sub, dt, 1.0, c->d);
 }
 
 /* 1 and (*du) the change of the approach speed u′ − u by the series above,
@@ -147,9 +167,8 @@ static inline int lub_drift_change(const lub_drift_t *c, const lub_pair_t *p, do
 {
     const double gap1 = gap0 - dt * u;
     if (!(c->ia > 0 && gap1 > 0 && gap1 < p->range && fabs(dt * u * c->ia) < c->zmax)) return 0;
-    const double *d = c->d, u2 = u * u;
-    const double q = (d[0] + d[1] * u) + u2 * (d[2] + d[3] * u) + u2 * u2 * ((d[4] + d[5] * u) + u2 * d[6]);
-    *du = u * q;
+    const double *d = c->d;
+    *du = lub_series_eval(u, d[0], d[1], d[2], d[3], d[4], d[5], d[6]);
     return 1;
 }
 
@@ -351,23 +370,17 @@ static void lub_coef_pass(const dem_lub_t *L, double dt, long np, double *const 
         rng[q] = ra;
         sub[q] = sb;
         /* lub_drift_coef, the d's times m* (the sweep's impulse m* (u′ − u)) */
-        const double kd = k * dt, ia = 1.0 / (gap0 + et), iM = 1.0 / (m + kd * (ia - sb));
-        const double b = kd * ia * iM, g = dt * m * iM * ia, mM = m * m * iM;
+        const double ia = 1.0 / (gap0 + et);
+        double dd[7];
+        zmax[q] = lub_series(m, k * dt, ia, sb, dt, m, dd);
         ia_[q] = gap0 > 0 && gap0 < ra ? ia : 0.0;
-        zmax[q] = 1e-3 / (b > 1.0 ? b : 1.0);
-        const double c2 = -0.5 * b, c3 = b * (0.5 * b - 1.0 / 3.0), c4 = b * (b * (5.0 / 6.0 - 0.625 * b) - 0.25);
-        const double c5 = b * (b * (b * (0.875 * b - 1.75) + 13.0 / 12.0) - 0.2);
-        const double c6 = b * (b * (b * (b * (3.5 - 1.3125 * b) - 119.0 / 36.0) + 77.0 / 60.0) - 1.0 / 6.0);
-        const double c7 =
-            b * (b * (b * (b * (b * (2.0625 * b - 6.875) + 8.75) - 236.0 / 45.0) + 29.0 / 20.0) - 1.0 / 7.0);
-        const double g2 = g * g, g3 = g2 * g, g4 = g2 * g2;
-        D0[q] = -m * kd * (ia - sb) * iM;
-        D1[q] = mM * c2 * g;
-        D2[q] = mM * c3 * g2;
-        D3[q] = mM * c4 * g3;
-        D4[q] = mM * c5 * g4;
-        D5[q] = mM * c6 * g4 * g;
-        D6[q] = mM * c7 * g3 * g3;
+        D0[q] = dd[0];
+        D1[q] = dd[1];
+        D2[q] = dd[2];
+        D3[q] = dd[3];
+        D4[q] = dd[4];
+        D5[q] = dd[5];
+        D6[q] = dd[6];
     }
 }
 
@@ -457,9 +470,8 @@ void dem_lubrication_impulses(dem_t *d, double dt)
         double J; /* impulse along n on i: m* times the change of the approach speed */
         const double ia = a[LW_IA][q];
         if (ia > 0 && gap1 > 0 && gap1 < range && fabs(dt * u * ia) < a[LW_ZMAX][q]) {
-            const double u2 = u * u, *D0 = a[LW_D0], *D1 = a[LW_D0 + 1], *D2 = a[LW_D0 + 2], *D3 = a[LW_D0 + 3],
-                         *D4 = a[LW_D0 + 4], *D5 = a[LW_D0 + 5], *D6 = a[LW_D0 + 6];
-            J = u * ((D0[q] + D1[q] * u) + u2 * (D2[q] + D3[q] * u) + u2 * u2 * ((D4[q] + D5[q] * u) + u2 * D6[q]));
+            const double *const *D = a + LW_D0;
+            J = lub_series_eval(u, D[0][q], D[1][q], D[2][q], D[3][q], D[4][q], D[5][q], D[6][q]);
             J = u > 0 ? fmin(fmax(J, -m * u), 0.0) : fmax(fmin(J, -m * u), 0.0);
         } else {
             const lub_pair_t p = {a[LW_ETA][q], range, a[LW_SUB][q], L->overlap};
