@@ -653,6 +653,7 @@ double dem_memory_per_particle(const dem_t *d)
     bytes += (double)d->nb_cap * (sizeof(int) + 2 + 3 * sizeof(double)) + (double)(d->n + 1) * sizeof(int);
     bytes += (double)(d->ncell + 1) * sizeof(int) + 2.0 * (d->n + 1) * sizeof(int);
     for (int w = 0; w < d->nwall; w++) bytes += (double)d->wall[w].cap * (sizeof(int) + 1 + 3 * sizeof(double));
+    bytes += (double)d->lub_work_cap * dem_lubrication_work_bytes();
     return bytes / n;
 }
 

@@ -283,6 +283,8 @@ void dem_lubrication_config(dem_t *d, cfg_t *cfg);
 void dem_lubrication_impulses(dem_t *d, double dt);
 /* Frees the work space of the lubrication sweep. */
 void dem_lubrication_free(dem_t *d);
+/* Bytes of the work space of the lubrication sweep per entry (d->lub_work_cap entries). */
+double dem_lubrication_work_bytes(void);
 /* Time for a lone pair (radius R for η_e and Δ_lub, R_eff, mass m) to close
  * gap0 from approach speed u0 with approach acceleration a under the
  * lubrication (INFINITY: it stops first). */

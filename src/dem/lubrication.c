@@ -306,26 +306,6 @@ typedef struct lub_work {
     double *a[LW_NA];
 } lub_work_t;
 
-static lub_work_t *lub_work(dem_t *d, long cap)
-{
-    if (cap > d->lub_work_cap || !d->lub_work) {
-        if (d->lub_work) {
-            free(d->lub_work->i);
-            free(d->lub_work->j);
-            free(d->lub_work->a[0]);
-        } else
-            d->lub_work = xcalloc(1, sizeof(lub_work_t));
-        if (cap < 64) cap = 64;
-        lub_work_t *w = d->lub_work;
-        w->i = xcalloc((size_t)cap, sizeof(int));
-        w->j = xcalloc((size_t)cap, sizeof(int));
-        w->a[0] = xcalloc((size_t)cap * LW_NA, sizeof(double));
-        for (int q = 1; q < LW_NA; q++) w->a[q] = w->a[0] + (size_t)q * cap;
-        d->lub_work_cap = cap;
-    }
-    return d->lub_work;
-}
-
 void dem_lubrication_free(dem_t *d)
 {
     if (!d->lub_work) return;
@@ -335,6 +315,31 @@ void dem_lubrication_free(dem_t *d)
     free(d->lub_work);
     d->lub_work = NULL;
     d->lub_work_cap = 0;
+}
+
+double dem_lubrication_work_bytes(void) { return 2 * sizeof(int) + LW_NA * sizeof(double); }
+
+/* The work space with room for `need` entries, the first `keep` kept
+ * (grown by doubling: it holds the selected entries, a few per particle). */
+static lub_work_t *lub_work(dem_t *d, long need, long keep)
+{
+    if (d->lub_work && need <= d->lub_work_cap) return d->lub_work;
+    long cap = d->lub_work_cap > 64 ? d->lub_work_cap : 64;
+    while (cap < need) cap *= 2;
+    lub_work_t *o = d->lub_work, *w = xcalloc(1, sizeof(lub_work_t));
+    w->i = xcalloc((size_t)cap, sizeof(int));
+    w->j = xcalloc((size_t)cap, sizeof(int));
+    w->a[0] = xcalloc((size_t)cap * LW_NA, sizeof(double));
+    for (int q = 1; q < LW_NA; q++) w->a[q] = w->a[0] + (size_t)q * cap;
+    if (o) {
+        memcpy(w->i, o->i, (size_t)keep * sizeof(int));
+        memcpy(w->j, o->j, (size_t)keep * sizeof(int));
+        for (int q = 0; q < LW_NA; q++) memcpy(w->a[q], o->a[q], (size_t)keep * sizeof(double));
+        dem_lubrication_free(d);
+    }
+    d->lub_work = w;
+    d->lub_work_cap = cap;
+    return w;
 }
 
 /* The second pass of lub_gather_pairs: from the centre-to-centre vectors,
@@ -411,10 +416,7 @@ static long lub_gather_pairs(dem_t *d, double dt)
             vfix2 = s2;
     }
     const double reach = vfix2 > 0 ? INFINITY : 4.0 * dt * sqrt(e2 * minv);
-    lub_work_t *W = lub_work(d, d->nb_start ? d->nb_start[d->nb_n_rows] : 0);
-    int *restrict wi = W->i, *restrict wj = W->j;
-    double *restrict nx = W->a[LW_NX], *restrict ny = W->a[LW_NY], *restrict nz = W->a[LW_NZ];
-    double *restrict mm = W->a[LW_M], *restrict eta = W->a[LW_ETA], *restrict rng = W->a[LW_RANGE];
+    lub_work_t *W = lub_work(d, 64, 0);
     long np = 0;
     for (int i = 0; i < d->nb_n_rows; i++)
         for (long e = d->nb_start[i]; e < d->nb_start[i + 1]; e++) {
@@ -430,14 +432,15 @@ static long lub_gather_pairs(dem_t *d, double dt)
             /* overlapping during the whole sweep (the contacts of a bed): no lubrication with overlap = off */
             const double B = ri + rj - reach;
             if (!L->overlap && B > 0 && c2 < B * B * (1.0 - 1e-9)) continue;
-            wi[np] = i;
-            wj[np] = j;
-            nx[np] = cx;
-            ny[np] = cy;
-            nz[np] = cz;
-            eta[np] = ri; /* R_i, R_j and 1/m_i + 1/m_j, until the second pass */
-            rng[np] = rj;
-            mm[np] = invm[i] + invm[j];
+            if (np == d->lub_work_cap) W = lub_work(d, np + 1, np);
+            W->i[np] = i;
+            W->j[np] = j;
+            W->a[LW_NX][np] = cx;
+            W->a[LW_NY][np] = cy;
+            W->a[LW_NZ][np] = cz;
+            W->a[LW_ETA][np] = ri; /* R_i, R_j and 1/m_i + 1/m_j, until the second pass */
+            W->a[LW_RANGE][np] = rj;
+            W->a[LW_M][np] = invm[i] + invm[j];
             np++;
         }
     lub_coef_pass(L, dt, np, W->a);
