@@ -27,6 +27,8 @@ void die_local(const char *fmt, ...) __attribute__((format(printf, 1, 2), noretu
 /* 64-byte aligned, zeroed allocation; dies on failure.  Free with free(). */
 void *xcalloc(size_t n, size_t size);
 
+/* Wall-clock seconds (MPI_Wtime); the calling thread's CPU seconds in a build with
+ * EXTRA_CFLAGS=-DIBMDEM_CPU_TIMERS (src/core/util.c). */
 double wtime(void);
 /* CPU time of the whole process (all threads), s: the benchmarks on a shared machine. */
 double cputime(void);

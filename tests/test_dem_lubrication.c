@@ -10,6 +10,8 @@
  *    (lubrication.c), so it is checked at every step to round-off, for a
  *    sphere against a wall and for a pair (reduced mass, R_eff = R/2), with
  *    momentum conserved to round-off for the pair.
+ *  - One step of a pair: the approach speed after it is the root of the
+ *    scheme's implicit equation, solved here by bisection in long double.
  *  - With St = m* u₀/k below ΔL = ln((Δ_lub + η_e)/η_e) the sphere stops at
  *    the gap where L(δ*) = L(δ₀) − St; above, it reaches contact at
  *    u_C = u₀ − (k/m*) ΔL, leaves it at ε_max u_C (the calibrated contact law)
@@ -31,6 +33,7 @@
  *    the contact time of the DEM itself; an approach that stops (St < ΔL)
  *    never touches (INFINITY); without lubrication it is gap/u exactly.
  */
+#include <gsl/gsl_rng.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -743,6 +746,74 @@ static void test_tangential_pair_properties(void **state)
     assert_true(diff < 1e-3 * scale);
 }
 
+/* One sub-step of a lone pair at gap δ₀ approaching at u (no gravity, no
+ * contact): the approach speed after the step is the root u′ of
+ *     m* (u′ − u) + k [L(δ₀) − L(δ₀ − Δt u′)] = 0
+ * (lubrication.c), here by bisection in long double.  Gaps from 1e-5 Δ_lub to
+ * Δ_lub and speeds from 1e-6 to 1 m/s, approaching and separating, with and
+ * without subtract_resolved: both the series of small drifts
+ * (|Δt u|/(δ₀ + η_e) < 1e-3) and the general Newton solve; steps whose drift
+ * closes the gap are left out (the contact force acts in their closing
+ * kick).  Bound 1e-14 |u|, the Newton solve's tolerance (measured: 6.5e-16). */
+static long double root_ref(long double ms, long double k, long double dt, long double gap0, long double u,
+                            long double eta, long double range, int subtract)
+{
+    long double lo = u < 0 ? u : 0, hi = u < 0 ? 0 : u;
+    for (int it = 0; it < 200; it++) {
+        const long double x = 0.5L * (lo + hi);
+        const long double d0 = gap0, d1 = gap0 - dt * x;
+        const long double c0 = d0 < 0 ? 0 : d0 > range ? range : d0, c1 = d1 < 0 ? 0 : d1 > range ? range : d1;
+        const long double sub = subtract ? 1.0L / (range + eta) : 0.0L;
+        const long double g = ms * (x - u) + k * (logl((c0 + eta) / (c1 + eta)) - (c0 - c1) * sub);
+        if (g > 0)
+            hi = x;
+        else
+            lo = x;
+    }
+    return 0.5L * (lo + hi);
+}
+
+static void test_step_root(void **state)
+{
+    (void)state;
+    const double eta = 2e-4 * R, range = 0.5 * R, m = RHO * 4.0 / 3.0 * M_PI * R * R * R, ms = 0.5 * m;
+    const double k = 6 * M_PI * MU * 0.25 * R * R, dt = TC / 50;
+    gsl_rng *rng = gsl_rng_alloc(gsl_rng_mt19937);
+    gsl_rng_set(rng, 19);
+    double worst = 0;
+    int nseries = 0, ngeneral = 0;
+    for (int t = 0; t < 400; t++) {
+        const int subtract = t % 2;
+        const double gap0 = range * pow(10.0, -5.0 * gsl_rng_uniform(rng)) * (1 - 1e-6);
+        const double u = (t % 4 < 2 ? 1 : -1) * pow(10.0, -6.0 * gsl_rng_uniform(rng));
+        dem_t *d = make(0, eta, range, subtract, 50, 0.0, 0.9);
+        const double xa[3] = {0.05, 0.05, 0.05 - R - gap0 / 2}, xb[3] = {0.05, 0.05, 0.05 + R + gap0 / 2};
+        const double va[3] = {0, 0, 0.5 * u}, vb[3] = {0, 0, -0.5 * u};
+        dem_add_particle(d, xa, va, R, RHO, 0);
+        dem_add_particle(d, xb, vb, R, RHO, 0);
+        assert_int_equal(dem_step(d), DEM_OK);
+        const double *v = dem_velocities(d);
+        const long *id = dem_ids(d);
+        const int a = id[0] == 0 ? 0 : 1, b = 1 - a;
+        const double up = v[3 * a + 2] - v[3 * b + 2];
+        /* the gap as the DEM has it (the positions' rounding moves the root by up to 1e-12 |u|) */
+        const double g0 = (xb[2] - xa[2] - R) - R;
+        const long double ref = root_ref(ms, k, dt, g0, u, eta, range, subtract);
+        dem_free(d);
+        if (g0 - dt * up <= 0) continue; /* the contact acted in the closing kick */
+        worst = fmax(worst, (double)fabsl(up - ref) / fabs(u));
+        if (fabs(dt * u) < 1e-3 * (g0 + eta) && g0 - dt * u > 0 && g0 - dt * u < range)
+            nseries++;
+        else
+            ngeneral++;
+    }
+    gsl_rng_free(rng);
+    printf("one step of a pair: largest |u' - root| %.2e |u| (%d steps of small drift, %d others)\n", worst, nseries,
+           ngeneral);
+    assert_true(nseries > 50 && ngeneral > 50);
+    assert_true(worst < 1e-14);
+}
+
 int main(int argc, char **argv)
 {
     test_mpi_init(&argc, &argv);
@@ -750,6 +821,7 @@ int main(int argc, char **argv)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_wall_first_integral),
         cmocka_unit_test(test_pair_first_integral),
+        cmocka_unit_test(test_step_root),
         cmocka_unit_test(test_stiff_small_roughness),
         cmocka_unit_test(test_overlap_restitution),
         cmocka_unit_test(test_overlap_force_at_contact),

@@ -141,6 +141,7 @@ void dem_free(dem_t *d)
                    d->r, d->invm, d->invI, d->rho, d->id, d->fixed};
     for (size_t a = 0; a < sizeof arr / sizeof arr[0]; a++) free(arr[a]);
     free(d->kernel_block);
+    dem_lubrication_free(d);
     for (int q = 0; q < DEM_MAX_THREADS; q++) {
         free(d->tblock[q]);
         free(d->tforce[q]);
@@ -652,6 +653,7 @@ double dem_memory_per_particle(const dem_t *d)
     bytes += (double)d->nb_cap * (sizeof(int) + 2 + 3 * sizeof(double)) + (double)(d->n + 1) * sizeof(int);
     bytes += (double)(d->ncell + 1) * sizeof(int) + 2.0 * (d->n + 1) * sizeof(int);
     for (int w = 0; w < d->nwall; w++) bytes += (double)d->wall[w].cap * (sizeof(int) + 1 + 3 * sizeof(double));
+    bytes += (double)d->lub_work_cap * dem_lubrication_work_bytes();
     return bytes / n;
 }
 

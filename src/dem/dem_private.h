@@ -227,6 +227,9 @@ struct dem {
         double contact_norm, contacts; /* Σ |F| and count of the contacts (pairs and walls) */
         double lub_norm, lubricated;   /* the same for the normal lubrication (every rank computes all) */
     } fstat;
+    /* work space of the lubrication sweep (lubrication.c), lub_work_cap entries */
+    struct lub_work *lub_work;
+    long lub_work_cap;
     /* timers */
     double t_pair, t_wall, t_build, t_integ, t_comm, t_lub;
 };
@@ -278,6 +281,10 @@ void dem_lubrication_config(dem_t *d, cfg_t *cfg);
 /* Apply the lubrication impulses of the coming drift of length dt to the
  * half-step velocities (implicit in the gap, see lubrication.c). */
 void dem_lubrication_impulses(dem_t *d, double dt);
+/* Frees the work space of the lubrication sweep. */
+void dem_lubrication_free(dem_t *d);
+/* Bytes of the work space of the lubrication sweep per entry (d->lub_work_cap entries). */
+double dem_lubrication_work_bytes(void);
 /* Time for a lone pair (radius R for η_e and Δ_lub, R_eff, mass m) to close
  * gap0 from approach speed u0 with approach acceleration a under the
  * lubrication (INFINITY: it stops first). */

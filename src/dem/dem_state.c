@@ -142,12 +142,12 @@ void dem_state_restore(dem_t *d, const dem_state_t *st)
     memcpy(d->nc, keep.nc, sizeof d->nc);
     memcpy(d->csize, keep.csize, sizeof d->csize);
     KEEP(ncell), KEEP(cell_start), KEEP(cell_of), KEEP(perm);
-    KEEP(kernel_block), KEEP(tforce_cap);
+    KEEP(kernel_block), KEEP(tforce_cap), KEEP(lub_work), KEEP(lub_work_cap);
     memcpy(d->tblock, keep.tblock, sizeof d->tblock);
     memcpy(d->tforce, keep.tforce, sizeof d->tforce);
     KEEP(observer), KEEP(observer_ctx);
     KEEP(nsnap), KEEP(snap_cap), KEEP(snap_t), KEEP(snap_n), KEEP(snap_index);
-    KEEP(t_pair), KEEP(t_wall), KEEP(t_build), KEEP(t_integ), KEEP(t_comm);
+    KEEP(t_pair), KEEP(t_wall), KEEP(t_build), KEEP(t_integ), KEEP(t_comm), KEEP(t_lub);
 #undef KEEP
 }
 

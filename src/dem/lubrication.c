@@ -31,7 +31,8 @@
  * after the impulse): a scalar equation per pair,
  *     m* (u′ − u) + k [L(δ₀) − L(δ₀ − Δt u′)] = 0,
  * whose left side increases strictly with u′, so it has one root, found by
- * safeguarded Newton iterations in a bracket (lub_solve).  The scheme is
+ * safeguarded Newton iterations in a bracket (lub_solve), or, when the drift
+ * is small against the film, by the series of lub_drift_coef.  The scheme is
  * implicit (unconditionally stable: a pair can never be pushed through
  * δ = −η_e by its own lubrication, whatever η_e/R and Δt), and for a lone
  * pair it keeps u − (k/m*) L(δ) constant exactly, the first integral of the
@@ -39,6 +40,8 @@
  * Pairs sharing a particle are solved one after the other in list order
  * (a Gauss–Seidel sweep, deterministic): each solve minimises a convex
  * function of the velocities, so the sweep is dissipative and stable.  The
+ * sweep first gathers the pairs it may lubricate and their constants
+ * (lub_gather_pairs), then runs the chain of solves.  The
  * force reported for output is the impulse divided by Δt.
  *
  * The lists must hold every pair within Δ_lub: the skin is widened by the
@@ -46,6 +49,7 @@
  * lists (displacement > skin/2 of the user's skin) still guarantees it.
  */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "dem_private.h"
@@ -91,6 +95,83 @@ static inline double lub_delta_potential(const lub_pair_t *p, double gap0, doubl
     return *L0 - lub_potential(p, d1);
 }
 
+/* The root of lub_solve when both gaps stay inside (0, Δ_lub) and the drift
+ * is small against the film, |Δt u|/(δ₀ + η_e) < 1e-3 (nearly every pair of a
+ * sub-cycled bed).  With a = δ₀ + η_e, z = Δt u′/a and H(z) = −ln(1 − z) − z,
+ * g of lub_solve reads
+ *     g = M u′ − m u + k H(z),   M = m + k Δt (1/a − 1/(Δ_lub + η_e) [subtract]),
+ * so z = z₀ − β H(z) with z₀ = γ u, γ = Δt m/(M a) (z₀ the linearly implicit
+ * step) and β = k Δt/(M a).  Its series reversion
+ *     z = z₀ + Σ_{n=2..7} c_n(β) z₀ⁿ,   c₂ = −β/2,  c₃ = β²/2 − β/3,
+ *     c₄ = −5β³/8 + 5β²/6 − β/4,  c₅ = 7β⁴/8 − 7β³/4 + 13β²/12 − β/5,
+ *     c₆ = −21β⁵/16 + 7β⁴/2 − 119β³/36 + 77β²/60 − β/6,
+ *     c₇ = 33β⁶/16 − 55β⁵/8 + 35β⁴/4 − 236β³/45 + 29β²/20 − β/7,
+ * is left at z₀⁷: with |z₀| and β|z₀| below 1e-3 the rest is below 1e-20 of
+ * z.  The change of the approach speed is then a polynomial in u,
+ *     u′ − u = u (d₀ + d₁ u + … + d₆ u⁶),
+ *     d₀ = −k Δt (1/a [− 1/(Δ_lub + η_e)])/M,  d_{n−1} = (m/M) c_n γ^{n−1},
+ * whose coefficients do not depend on u (lub_drift_coef): the Gauss–Seidel
+ * sweep computes them before it starts and each of its solves is a few
+ * multiplications (lub_drift_change). */
+typedef struct {
+    double ia, zmax; /* 1/a (0: δ₀ outside (0, Δ_lub)); the largest |Δt u/a| of the series */
+    double d[7];     /* d₀ … d₆ */
+} lub_drift_t;
+
+/* The coefficients d₀ … d₆ times `scale` (1, or m* for the impulse) of a
+ * pair of mass m, k Δt = kd, 1/a = ia, 1/(Δ_lub + η_e) or 0 = sub; returns
+ * the bound of |Δt u/a| below which the series holds, 1e-3/max(1, β).
+ * Without branches (the sweep's constants are computed by a vectorised loop). */
+static inline double lub_series(double m, double kd, double ia, double sub, double dt, double scale, double d[7])
+{
+    const double iM = 1.0 / (m + kd * (ia - sub));
+    const double b = kd * ia * iM, g = dt * m * iM * ia, mM = scale * m * iM;
+    const double c2 = -0.5 * b, c3 = b * (0.5 * b - 1.0 / 3.0), c4 = b * (b * (5.0 / 6.0 - 0.625 * b) - 0.25);
+    const double c5 = b * (b * (b * (0.875 * b - 1.75) + 13.0 / 12.0) - 0.2);
+    const double c6 = b * (b * (b * (b * (3.5 - 1.3125 * b) - 119.0 / 36.0) + 77.0 / 60.0) - 1.0 / 6.0);
+    const double c7 = b * (b * (b * (b * (b * (2.0625 * b - 6.875) + 8.75) - 236.0 / 45.0) + 29.0 / 20.0) - 1.0 / 7.0);
+    const double g2 = g * g, g3 = g2 * g, g4 = g2 * g2;
+    d[0] = -scale * kd * (ia - sub) * iM;
+    d[1] = mM * c2 * g;
+    d[2] = mM * c3 * g2;
+    d[3] = mM * c4 * g3;
+    d[4] = mM * c5 * g4;
+    d[5] = mM * c6 * g4 * g;
+    d[6] = mM * c7 * g3 * g3;
+    return 1e-3 / (b > 1.0 ? b : 1.0);
+}
+
+/* u (d₀ + d₁ u + … + d₆ u⁶), in a short chain of operations. */
+static inline double lub_series_eval(double u, double d0, double d1, double d2, double d3, double d4, double d5,
+                                     double d6)
+{
+    const double u2 = u * u;
+    return u * ((d0 + d1 * u) + u2 * (d2 + d3 * u) + u2 * u2 * ((d4 + d5 * u) + u2 * d6));
+}
+
+static inline void lub_drift_coef(const lub_pair_t *p, double m, double k, double dt, double gap0, lub_drift_t *c)
+{
+    if (!(gap0 > 0 && gap0 < p->range)) {
+        c->ia = 0.0;
+        return;
+    }
+    c->ia = 1.0 / (gap0 + p->eta);
+    c->zmax = lub_series(m, k * dt, c->ia, p->sub, dt, 1.0, c->d);
+}
+
+/* 1 and (*du) the change of the approach speed u′ − u by the series above,
+ * or 0 when its conditions do not hold (the general solve of lub_solve);
+ * (d₀ … d₆ may be the d's times a constant: *du is then scaled by it). */
+static inline int lub_drift_change(const lub_drift_t *c, const lub_pair_t *p, double dt, double gap0, double u,
+                                   double *du)
+{
+    const double gap1 = gap0 - dt * u;
+    if (!(c->ia > 0 && gap1 > 0 && gap1 < p->range && fabs(dt * u * c->ia) < c->zmax)) return 0;
+    const double *d = c->d;
+    *du = lub_series_eval(u, d[0], d[1], d[2], d[3], d[4], d[5], d[6]);
+    return 1;
+}
+
 /* Root u′ of g(u′) = m (u′ − u) + k [L(δ₀) − L(δ₀ − dt u′)] = 0.
  *
  * Bracket.  g′ = m + k dt L′ ≥ m > 0, g(0) = −m u and g(u) has the sign of
@@ -102,10 +183,17 @@ static inline double lub_delta_potential(const lub_pair_t *p, double gap0, doubl
 static double lub_solve(const lub_pair_t *p, double m, double k, double dt, double gap0, double u)
 {
     if (u == 0) return 0.0;
+    double x;
+    lub_drift_t c;
+    lub_drift_coef(p, m, k, dt, gap0, &c);
+    if (lub_drift_change(&c, p, dt, gap0, u, &x)) {
+        x += u;
+        return u > 0 ? fmin(fmax(x, 0.0), u) : fmin(fmax(x, u), 0.0);
+    }
     double L0 = NAN;
     double lo = fmin(u, 0.0), hi = fmax(u, 0.0);
     const double scale = fabs(u);
-    double x = u * m / (m + k * dt * lub_potential_slope(p, gap0));
+    x = u * m / (m + k * dt * lub_potential_slope(p, gap0));
     if (!(x > lo && x < hi)) x = 0.5 * (lo + hi);
     for (int it = 0; it < 200; it++) {
         const double g = m * (x - u) + k * lub_delta_potential(p, gap0, dt * x, &L0);
@@ -132,10 +220,16 @@ static double lub_solve(const lub_pair_t *p, double m, double k, double dt, doub
  * value at the cut-off. */
 static inline int lub_complements_grid(const dem_lub_t *L) { return L->model == LUB_CORRECTION && L->h > 0; }
 
+/* Δ_lub of a particle of radius R (the smaller of a pair). */
+static inline double lub_pair_range(const dem_lub_t *L, double R)
+{
+    return lub_complements_grid(L) ? L->cutoff * L->h : L->range * R;
+}
+
 static inline void lub_params(const dem_lub_t *L, double R, lub_pair_t *p)
 {
     p->eta = L->roughness * R;
-    p->range = lub_complements_grid(L) ? L->cutoff * L->h : L->range * R;
+    p->range = lub_pair_range(L, R);
     p->sub = L->subtract || lub_complements_grid(L) ? 1.0 / (p->range + p->eta) : 0.0;
     p->overlap = L->overlap;
 }
@@ -203,6 +297,156 @@ double dem_lub_approach_time(const dem_t *d, double R, double reff, double m, do
 
 static void lub_tangential_impulses(dem_t *d, double dt);
 
+/* The entries of the lists that the sweep may lubricate, as arrays (one
+ * block, d->lub_work): their indices, and at the start of the sweep their
+ * geometry and the constants of their solves. */
+enum { LW_NX, LW_NY, LW_NZ, LW_GAP, LW_M, LW_K, LW_ETA, LW_RANGE, LW_SUB, LW_IA, LW_ZMAX, LW_D0, LW_NA = LW_D0 + 7 };
+typedef struct lub_work {
+    int *i, *j;
+    double *a[LW_NA];
+} lub_work_t;
+
+void dem_lubrication_free(dem_t *d)
+{
+    if (!d->lub_work) return;
+    free(d->lub_work->i);
+    free(d->lub_work->j);
+    free(d->lub_work->a[0]);
+    free(d->lub_work);
+    d->lub_work = NULL;
+    d->lub_work_cap = 0;
+}
+
+double dem_lubrication_work_bytes(void) { return 2 * sizeof(int) + LW_NA * sizeof(double); }
+
+/* The work space with room for `need` entries, the first `keep` kept
+ * (grown by doubling: it holds the selected entries, a few per particle). */
+static lub_work_t *lub_work(dem_t *d, long need, long keep)
+{
+    if (d->lub_work && need <= d->lub_work_cap) return d->lub_work;
+    long cap = d->lub_work_cap > 64 ? d->lub_work_cap : 64;
+    while (cap < need) cap *= 2;
+    lub_work_t *o = d->lub_work, *w = xcalloc(1, sizeof(lub_work_t));
+    w->i = xcalloc((size_t)cap, sizeof(int));
+    w->j = xcalloc((size_t)cap, sizeof(int));
+    w->a[0] = xcalloc((size_t)cap * LW_NA, sizeof(double));
+    for (int q = 1; q < LW_NA; q++) w->a[q] = w->a[0] + (size_t)q * cap;
+    if (o) {
+        memcpy(w->i, o->i, (size_t)keep * sizeof(int));
+        memcpy(w->j, o->j, (size_t)keep * sizeof(int));
+        for (int q = 0; q < LW_NA; q++) memcpy(w->a[q], o->a[q], (size_t)keep * sizeof(double));
+        dem_lubrication_free(d);
+    }
+    d->lub_work = w;
+    d->lub_work_cap = cap;
+    return w;
+}
+
+/* The second pass of lub_gather_pairs: from the centre-to-centre vectors,
+ * R_i, R_j and 1/m_i + 1/m_j (in nx.., eta, range, m) the normals, gaps and
+ * constants (lub_params, lub_drift_coef with the d's times m*, the sweep's
+ * impulse m* (u′ − u)) of np entries, without branches. */
+static void lub_coef_pass(const dem_lub_t *L, double dt, long np, double *const *A)
+{
+    double *restrict nx = A[LW_NX], *restrict ny = A[LW_NY], *restrict nz = A[LW_NZ], *restrict gap = A[LW_GAP];
+    double *restrict mm = A[LW_M], *restrict kk = A[LW_K], *restrict eta = A[LW_ETA], *restrict rng = A[LW_RANGE];
+    double *restrict sub = A[LW_SUB], *restrict ia_ = A[LW_IA], *restrict zmax = A[LW_ZMAX];
+    double *restrict D0 = A[LW_D0], *restrict D1 = A[LW_D0 + 1], *restrict D2 = A[LW_D0 + 2],
+           *restrict D3 = A[LW_D0 + 3], *restrict D4 = A[LW_D0 + 4], *restrict D5 = A[LW_D0 + 5],
+           *restrict D6 = A[LW_D0 + 6];
+    const double k0 = 6.0 * M_PI * L->viscosity, rough = L->roughness;
+    const int grid = lub_complements_grid(L), subtract = L->subtract || grid;
+    const double lrange = L->range, grange = L->cutoff * L->h;
+    /* the entries are independent (the arrays do not overlap) */
+#pragma GCC ivdep
+    for (long q = 0; q < np; q++) {
+        const double ri = eta[q], rj = rng[q], R = ri < rj ? ri : rj;
+        const double dist = sqrt(nx[q] * nx[q] + ny[q] * ny[q] + nz[q] * nz[q]), idist = 1.0 / dist;
+        nx[q] *= idist;
+        ny[q] *= idist;
+        nz[q] *= idist;
+        const double gap0 = dist - ri - rj, et = rough * R, ra = grid ? grange : lrange * R;
+        const double sb = subtract ? 1.0 / (ra + et) : 0.0;
+        const double m = 1.0 / mm[q], reff = ri * rj / (ri + rj), k = k0 * reff * reff;
+        gap[q] = gap0;
+        mm[q] = m;
+        kk[q] = k;
+        eta[q] = et;
+        rng[q] = ra;
+        sub[q] = sb;
+        /* lub_drift_coef, the d's times m* (the sweep's impulse m* (u′ − u)) */
+        const double ia = 1.0 / (gap0 + et);
+        double dd[7];
+        zmax[q] = lub_series(m, k * dt, ia, sb, dt, m, dd);
+        ia_[q] = gap0 > 0 && gap0 < ra ? ia : 0.0;
+        D0[q] = dd[0];
+        D1[q] = dd[1];
+        D2[q] = dd[2];
+        D3[q] = dd[3];
+        D4[q] = dd[4];
+        D5[q] = dd[5];
+        D6[q] = dd[6];
+    }
+}
+
+/* The entries of the pair lists within reach of Δ_lub during a sweep of step
+ * dt, in list order, into d->lub_work; returns their number.  A pair is
+ * lubricated when one of its gaps δ₀, δ₀ − Δt u is below Δ_lub, and
+ * |u| ≤ |v_i| + |v_j| at any moment of the sweep.  Each solve of the sweep
+ * conserves the pair's momentum and does not reverse its approach: with the
+ * fixed particles at rest it does not increase the kinetic energy E of the
+ * mobile particles, so during the sweep |v_i| ≤ V = √(2E/m_min), E taken
+ * before it, and a pair is out of reach when its centres are further apart
+ * than R_i + R_j + Δ_lub + 2 Δt V (twice that, against round-off), or, with
+ * overlap = off, closer than R_i + R_j − 2 Δt V (both gaps negative).  With a
+ * moving fixed particle every entry is taken.  A first pass selects the
+ * entries, a second one, without branches (vectorised), computes their
+ * normals, gaps and the coefficients of lub_drift_coef. */
+static long lub_gather_pairs(dem_t *d, double dt)
+{
+    const dem_lub_t *L = &d->lub;
+    const double *restrict x = d->x, *restrict v = d->v, *restrict r = d->r, *restrict invm = d->invm;
+    double e2 = 0.0, minv = 0.0, vfix2 = 0.0; /* 2E, largest 1/m, largest |v|^2 of the fixed particles */
+    for (int i = 0; i < d->n; i++) {
+        const double s2 = v[3 * i] * v[3 * i] + v[3 * i + 1] * v[3 * i + 1] + v[3 * i + 2] * v[3 * i + 2];
+        if (invm[i] > 0) {
+            e2 += s2 / invm[i];
+            if (invm[i] > minv) minv = invm[i];
+        } else if (s2 > vfix2)
+            vfix2 = s2;
+    }
+    const double reach = vfix2 > 0 ? INFINITY : 4.0 * dt * sqrt(e2 * minv);
+    lub_work_t *W = lub_work(d, 64, 0);
+    long np = 0;
+    for (int i = 0; i < d->nb_n_rows; i++)
+        for (long e = d->nb_start[i]; e < d->nb_start[i + 1]; e++) {
+            const int j = d->nb_j[e];
+            if (invm[i] == 0 && invm[j] == 0) continue;
+            const double ri = r[i], rj = r[j];
+            const double A = ri + rj + lub_pair_range(L, ri < rj ? ri : rj) + reach;
+            const double *sh = d->any_periodic ? d->shift[d->nb_img[e]] : d->shift[13];
+            const double cx = x[3 * j] + sh[0] - x[3 * i], cy = x[3 * j + 1] + sh[1] - x[3 * i + 1],
+                         cz = x[3 * j + 2] + sh[2] - x[3 * i + 2];
+            const double c2 = cx * cx + cy * cy + cz * cz;
+            if (c2 > A * A * (1.0 + 1e-9)) continue;
+            /* overlapping during the whole sweep (the contacts of a bed): no lubrication with overlap = off */
+            const double B = ri + rj - reach;
+            if (!L->overlap && B > 0 && c2 < B * B * (1.0 - 1e-9)) continue;
+            if (np == d->lub_work_cap) W = lub_work(d, np + 1, np);
+            W->i[np] = i;
+            W->j[np] = j;
+            W->a[LW_NX][np] = cx;
+            W->a[LW_NY][np] = cy;
+            W->a[LW_NZ][np] = cz;
+            W->a[LW_ETA][np] = ri; /* R_i, R_j and 1/m_i + 1/m_j, until the second pass */
+            W->a[LW_RANGE][np] = rj;
+            W->a[LW_M][np] = invm[i] + invm[j];
+            np++;
+        }
+    lub_coef_pass(L, dt, np, W->a);
+    return np;
+}
+
 void dem_lubrication_impulses(dem_t *d, double dt)
 {
     const dem_lub_t *L = &d->lub;
@@ -210,31 +454,44 @@ void dem_lubrication_impulses(dem_t *d, double dt)
     const double *restrict r = d->r, *restrict invm = d->invm;
     memset(fl, 0, 3 * (size_t)d->n * sizeof(double));
     const double k0 = 6.0 * M_PI * L->viscosity;
-    /* particle pairs, in list order */
-    for (int i = 0; i < d->nb_n_rows; i++) {
-        for (long e = d->nb_start[i]; e < d->nb_start[i + 1]; e++) {
-            const int j = d->nb_j[e];
-            if (invm[i] == 0 && invm[j] == 0) continue;
-            double n[3];
-            const double ri = r[i], rj = r[j], gap0 = dem_pair_normal(d, i, e, n) - ri - rj;
-            lub_pair_t p;
-            lub_params(L, ri < rj ? ri : rj, &p);
-            const double u = dem_pair_approach(d, i, j, n), gap1 = gap0 - dt * u;
-            if ((gap0 >= p.range && gap1 >= p.range) || (!p.overlap && gap0 <= 0 && gap1 <= 0)) continue;
-            const double m = 1.0 / (invm[i] + invm[j]), reff = ri * rj / (ri + rj);
-            const double du = lub_solve(&p, m, k0 * reff * reff, dt, gap0, u) - u; /* change of the approach speed */
-            const double J = m * du;                                                /* impulse along n on i */
-            if (d->fstat.on) {
-                d->fstat.lub_norm += fabs(J) / dt;
-                d->fstat.lubricated += 1.0;
-            }
-            for (int a = 0; a < 3; a++) {
-                v[3 * i + a] += J * invm[i] * n[a];
-                v[3 * j + a] -= J * invm[j] * n[a];
-                fl[3 * i + a] += J / dt * n[a];
-                fl[3 * j + a] -= J / dt * n[a];
-            }
+    /* particle pairs, in list order: first the geometry of the entries that
+     * can be lubricated during this sweep (it does not depend on the
+     * velocities the sweep changes), then the sweep itself, a chain of
+     * dependent solves that only reads the velocities */
+    const long np = lub_gather_pairs(d, dt);
+    const lub_work_t *W = d->lub_work;
+    const int *restrict wi = W->i, *restrict wj = W->j;
+    const double *const *a = (const double *const *)W->a;
+    double jsum = 0.0;
+    long nlub = 0;
+    for (long q = 0; q < np; q++) {
+        const int i = wi[q], j = wj[q];
+        const double n[3] = {a[LW_NX][q], a[LW_NY][q], a[LW_NZ][q]};
+        const double u = dem_pair_approach(d, i, j, n), gap0 = a[LW_GAP][q], range = a[LW_RANGE][q];
+        const double gap1 = gap0 - dt * u, m = a[LW_M][q];
+        if ((gap0 >= range && gap1 >= range) || (!L->overlap && gap0 <= 0 && gap1 <= 0)) continue;
+        double J; /* impulse along n on i: m* times the change of the approach speed */
+        const double ia = a[LW_IA][q];
+        if (ia > 0 && gap1 > 0 && gap1 < range && fabs(dt * u * ia) < a[LW_ZMAX][q]) {
+            const double *const *D = a + LW_D0;
+            J = lub_series_eval(u, D[0][q], D[1][q], D[2][q], D[3][q], D[4][q], D[5][q], D[6][q]);
+            J = u > 0 ? fmin(fmax(J, -m * u), 0.0) : fmax(fmin(J, -m * u), 0.0);
+        } else {
+            const lub_pair_t p = {a[LW_ETA][q], range, a[LW_SUB][q], L->overlap};
+            J = m * (lub_solve(&p, m, a[LW_K][q], dt, gap0, u) - u);
         }
+        jsum += fabs(J);
+        nlub++;
+        for (int c = 0; c < 3; c++) {
+            v[3 * i + c] += J * invm[i] * n[c];
+            v[3 * j + c] -= J * invm[j] * n[c];
+            fl[3 * i + c] += J / dt * n[c];
+            fl[3 * j + c] -= J / dt * n[c];
+        }
+    }
+    if (d->fstat.on) {
+        d->fstat.lub_norm += jsum / dt;
+        d->fstat.lubricated += (double)nlub;
     }
     /* walls: R_eff → R_i, the wall moves with its velocity and has infinite mass */
     if (L->walls)
