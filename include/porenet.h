@@ -49,7 +49,12 @@ typedef struct {
     pn_bc_t bc[6];      /* flow condition of each wall face */
     double bc_value[6]; /* PN_BC_PRESSURE: pressure (Pa); PN_BC_FLUX: volume flux INTO the domain (m³/s) */
     double grad[3];     /* periodic axes: imposed mean pressure gradient ∇p (Pa/m) */
+    double clear_h;     /* > 0: pores whose power radius exceeds this (m) are clear fluid at the hydrostatic
+                           pressure (dirichlet = PN_CLEAR); 0: off (porenet.clear_fluid_radius) */
 } pn_domain_t;
+
+/* net->dirichlet of a clear-fluid pore (the other Dirichlet pores hold the face 0..5 of their value). */
+#define PN_CLEAR 6
 
 /* ---- regular triangulation (triangulate.c) ---------------------------------- */
 
@@ -217,6 +222,7 @@ typedef struct {
     double margin;      /* image layer (0: auto) */
     int margin_warned;  /* warned once: 1 the given margin was widened, 2 some pores need more than the widest */
     double margin_used; /* the width of the last triangulation (the next one starts from it) */
+    double clear_radius; /* porenet.clear_fluid_radius: dom.clear_h in mean diameters of the spheres (0: off) */
     double rho_f;       /* fluid density (Reynolds number, buoyancy) */
     int n;
     pn_tri_t tri;
@@ -259,6 +265,14 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r);
  * x during dt (dt <= 0 or first call: rigid skeleton, no volume change).
  * Re-triangulates when due, solves, computes m->f.  0 or -1 (m->err). */
 int pn_model_step(pn_model_t *m, int n, const double *x, const double *r, double dt);
+/* The pore whose tetrahedra hold point y at the positions of the last step
+ * (a point of the box; its periodic copies and mirror images across the walls
+ * are tried too): the pressure there
+ * is m->p of that pore (pressure probes); PN_CLEAR_AT (with the clear fluid
+ * on): a tetrahedron of the clear fluid that is no pore of the box, or no
+ * tetrahedron (beyond the cloud of spheres and images): hydrostatic; -1: none. */
+#define PN_CLEAR_AT (-2)
+int pn_model_pore_at(const pn_model_t *m, const double y[3]);
 void pn_model_free(pn_model_t *m);
 /* The model's exact state in an HDF5 group of a checkpoint (state.c): the
  * positions of the last triangulation, the previous positions and pore
