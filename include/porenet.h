@@ -49,8 +49,9 @@ typedef struct {
     pn_bc_t bc[6];      /* flow condition of each wall face */
     double bc_value[6]; /* PN_BC_PRESSURE: pressure (Pa); PN_BC_FLUX: volume flux INTO the domain (m³/s) */
     double grad[3];     /* periodic axes: imposed mean pressure gradient ∇p (Pa/m) */
-    double clear_h;     /* > 0: pores whose power radius exceeds this (m) are clear fluid at the hydrostatic
-                           pressure (dirichlet = PN_CLEAR); 0: off (porenet.clear_fluid_radius) */
+    double clear_h;     /* > 0: pores whose power radius exceeds this (m), connected through such pores to the
+                           outside of the packing, are clear fluid at the hydrostatic pressure
+                           (dirichlet = PN_CLEAR; pn_tri_t.clear); 0: off (porenet.clear_fluid_radius) */
 } pn_domain_t;
 
 /* net->dirichlet of a clear-fluid pore (the other Dirichlet pores hold the face 0..5 of their value). */
@@ -77,6 +78,8 @@ typedef struct {
     double margin;      /* width of the image layer */
     double margin_needed; /* the width the tetrahedra of the box need (≤ margin) */
     int n_flat;         /* lower facets whose tetrahedron is flat (power centre from the hyperplane) */
+    unsigned char *clear; /* ntet: tetrahedron of the clear fluid (dom->clear_h): power radius above clear_h and
+                             connected through such tetrahedra to the rim of the cloud (NULL: none) */
 } pn_tri_t;
 
 /* Regular triangulation of n spheres (x: 3n, r: n) in the domain.  Returns 0,

@@ -184,6 +184,12 @@ static void ensure_started(porenet_part_t *pp)
         "factorisation %.3g s\n",
         pp->n, pp->m.net.npore, (double)pp->m.net.npore / pp->n, pp->m.net.nthroat, pp->m.t_tri, pp->m.t_net,
         pp->m.t_factor);
+    if (pp->m.dom.clear_h > 0) {
+        int nc = 0;
+        for (int i = 0; i < pp->m.net.npore; i++) nc += pp->m.net.dirichlet[i] == PN_CLEAR;
+        msg("porenet: %d pores of the clear fluid (power radius above %g m = porenet.clear_fluid_radius mean "
+            "diameters, connected to the outside of the packing): hydrostatic\n", nc, pp->m.dom.clear_h);
+    }
     if (pp->with_dem)
         msg("porenet: coupled with the DEM, viscous step limit %.4g s (DEM step %.4g s)\n", pn_coupled_dt(&pp->m, pp->d),
             dem_dt(pp->d));

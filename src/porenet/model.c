@@ -363,10 +363,7 @@ int pn_model_pore_at(const pn_model_t *m, const double y[3])
         double v[4][3];
         for (int q = 0; q < 4; q++) pn_tri_point(&m->dom, &m->tri, m->x_prev, m->tri.tet[4 * k + q], v[q]);
         if (!in_tet(v[0], v[1], v[2], v[3], y)) continue;
-        const double *P = m->tri.P + 3 * k;
-        const double w = (P[0] - v[0][0]) * (P[0] - v[0][0]) + (P[1] - v[0][1]) * (P[1] - v[0][1]) +
-                         (P[2] - v[0][2]) * (P[2] - v[0][2]) - m->tri.r[m->tri.tet[4 * k]] * m->tri.r[m->tri.tet[4 * k]];
-        return w > m->dom.clear_h * m->dom.clear_h ? PN_CLEAR_AT : -1;
+        return m->tri.clear && m->tri.clear[k] ? PN_CLEAR_AT : -1;
     }
     /* outside the triangulated cloud (spheres and images): beyond the packing, in the clear fluid */
     return m->dom.clear_h > 0 ? PN_CLEAR_AT : -1;

@@ -309,18 +309,11 @@ static void wall_throats_yade(const pn_domain_t *dom, const pn_params_t *prm, co
     free(key);
 }
 
-/* A tetrahedron of the clear fluid (dom->clear_h): its power radius, the
- * radius of the largest sphere orthogonal to its four spheres, exceeds the
- * threshold (the pore could hold a grain larger than the packing's: it is
- * outside the packing, the α-shape criterion with α = clear_h). */
+/* A tetrahedron of the clear fluid (pn_tri_t.clear, triangulate.c). */
 static int tet_clear(const pn_domain_t *dom, const pn_tri_t *t, int tt)
 {
-    if (!(dom->clear_h > 0)) return 0;
-    const int v = t->tet[4 * tt];
-    const double *P = t->P + 3 * tt, *c = t->x + 3 * (size_t)v;
-    const double w = (P[0] - c[0]) * (P[0] - c[0]) + (P[1] - c[1]) * (P[1] - c[1]) + (P[2] - c[2]) * (P[2] - c[2]) -
-                     t->r[v] * t->r[v];
-    return w > dom->clear_h * dom->clear_h;
+    (void)dom;
+    return t->clear && t->clear[tt];
 }
 
 int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tri_t *t, const double *x,
