@@ -149,6 +149,9 @@ typedef struct {
     double void_sum, solid_area_sum; /* Σ w φ_ij, Σ w γ_ij (partition checks) */
     double box_volume, solid_volume; /* box volume; Σ (4/3)π r³ of the spheres */
     int n_negative_area;             /* facets whose fluid area was ≤ 0 (overlaps) */
+    int n_seam;                      /* with the clear fluid: neighbours across a periodic face that are no pore of
+                                        the box (a period narrower than the image layer the pores need), taken
+                                        as the pore of the box nearest to their power centre */
 } pn_net_t;
 
 /* Build the network of a triangulation for sphere positions x / radii r.  0; -2 when a pore of

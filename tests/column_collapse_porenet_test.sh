@@ -9,13 +9,13 @@
 #     bed; moving average over 0.02 s) first leaves the band of +-1.5 % of Delta rho g H0 downwards
 #     in the dense column (dilation) and upwards in the loose one (compaction): the signs of Izard's
 #     Fig. 5.14a and of the resolved runs (column_collapse_test.sh).  Measured (series every coupled
-#     step): dense first -0.017 at 0.017 s, down to -0.051 (0.07 s); loose first +0.016 at 0.008 s,
-#     up to +0.052 (0.024 s), negative from 0.035 s (-0.11 at 0.045 s): the band is a third of the
+#     step): dense first -0.017 at 0.017 s, down to -0.051 (0.07 s); loose first +0.017 at 0.008 s,
+#     up to +0.053 (0.024 s), negative from 0.035 s (-0.12 at 0.045 s): the band is a third of the
 #     dense extreme and of the loose positive peak (the full runs to 0.6 s: README.md);
 #  3. restart = uninterrupted run with the clear fluid and the probes: 60 coupled steps of the loose
 #     column straight and 30 + --restart + 30 give bit-identical particles, pore pressures and
 #     series rows.
-# 34 s wall (21 s CPU) on the shared 2 cores.
+# 34-47 s wall (21-22 s CPU) on the shared 2 cores.
 . "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_collapse_pn.XXXXXX)
 C=cases/column_collapse

@@ -295,7 +295,8 @@ int pn_model_validity(const pn_model_t *m, const double *r, char *buf, size_t nb
         umax = fmax(umax, fabs(q) / m->net.area[f]);
     }
     double vv = 0, vt = 0;
-    for (int i = 0; i < m->net.npore; i++) vv += m->net.vvoid[i], vt += m->net.vol[i];
+    for (int i = 0; i < m->net.npore; i++)
+        if (m->net.dirichlet[i] != PN_CLEAR) vv += m->net.vvoid[i], vt += m->net.vol[i]; /* the packing's */
     *re = m->rho_f * umax * 2 * rmean / m->prm.mu;
     *size_ratio = rmin / rmean;
     *porosity = vt > 0 ? vv / vt : NAN;

@@ -558,6 +558,28 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
                 }
                 int pj = canon[nb];
                 if (pj < 0 && clear_j) pj = any_clear;
+                int seam = 0;
+                if (pj < 0 && dom->clear_h > 0) {
+                    /* a packing that does not fill the box in a period narrower than the image layer its
+                     * pores need (the column collapse): the pore of the box nearest to the copy's power
+                     * centre brought into the box */
+                    double q[3], best = INFINITY;
+                    for (int a = 0; a < 3; a++) {
+                        q[a] = cP[3 * nb + a];
+                        if (dom->periodic[a]) {
+                            const double L = dom->hi[a] - dom->lo[a];
+                            q[a] -= L * floor((q[a] - dom->lo[a]) / L);
+                        }
+                    }
+                    for (int pk = 0; pk < np; pk++) {
+                        const double *P = cP + 3 * proot[pk];
+                        const double d2 = (P[0] - q[0]) * (P[0] - q[0]) + (P[1] - q[1]) * (P[1] - q[1]) +
+                                          (P[2] - q[2]) * (P[2] - q[2]);
+                        if (d2 < best && pk != pi) best = d2, pj = pk;
+                    }
+                    seam = pj >= 0;
+                    net->n_seam += seam;
+                }
                 if (pj < 0) {
                     status = pn_fail(err, nerr, "pore %d: the periodic copy of a neighbour has no canonical pore", pi);
                     break;
@@ -566,7 +588,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
                 sub3(cP + 3 * nb, cP + 3 * c, dx);
                 /* count each facet once: from the pore with the smaller index,
                  * or, between a pore and its own periodic copy, along +shift */
-                if (pj < pi && !clear_j) continue;
+                if (pj < pi && !clear_j && !seam) continue;
                 if (pj == pi) {
                     double s[3];
                     sub3(cP + 3 * nb, cP + 3 * proot[pj], s);
