@@ -96,6 +96,13 @@ typedef enum { PN_TRI_CGAL = 0, PN_TRI_QHULL } pn_tri_kind_t;
 int pn_triangulate_with(const pn_domain_t *dom, int n, const double *x, const double *r, double margin,
                         pn_tri_kind_t kind, pn_tri_t *t, char *err, size_t nerr);
 void pn_tri_free(pn_tri_t *t);
+/* The clear fluid (clear.c): t->clear, the tetrahedra whose power radius exceeds
+ * dom->clear_h connected through such tetrahedra to the rim of the cloud (left
+ * NULL when dom->clear_h is 0; pn_triangulate calls it). */
+void pn_mark_clear(const pn_domain_t *dom, pn_tri_t *t);
+/* The pore (of np, their power centres cP + 3 root[k]) nearest to point P
+ * brought into the box along the periodic axes, pore `skip` excluded (clear.c). */
+int pn_nearest_pore(const pn_domain_t *dom, const double *cP, const int *root, int np, int skip, const double P[3]);
 /* Position of extended point `p` for sphere positions x (images follow their sphere). */
 void pn_tri_point(const pn_domain_t *dom, const pn_tri_t *t, const double *x, int p, double out[3]);
 

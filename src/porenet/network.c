@@ -563,20 +563,9 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
                     /* a packing that does not fill the box in a period narrower than the image layer its
                      * pores need (the column collapse): the pore of the box nearest to the copy's power
                      * centre brought into the box */
-                    double q[3], best = INFINITY;
-                    for (int a = 0; a < 3; a++) {
-                        q[a] = cP[3 * nb + a];
-                        if (dom->periodic[a]) {
-                            const double L = dom->hi[a] - dom->lo[a];
-                            q[a] -= L * floor((q[a] - dom->lo[a]) / L);
-                        }
-                    }
-                    for (int pk = 0; pk < np; pk++) {
-                        const double *P = cP + 3 * proot[pk];
-                        const double d2 = (P[0] - q[0]) * (P[0] - q[0]) + (P[1] - q[1]) * (P[1] - q[1]) +
-                                          (P[2] - q[2]) * (P[2] - q[2]);
-                        if (d2 < best && pk != pi) best = d2, pj = pk;
-                    }
+                    double q[3];
+                    for (int a = 0; a < 3; a++) q[a] = cP[3 * nb + a];
+                    pj = pn_nearest_pore(dom, cP, proot, np, pi, q);
                     seam = pj >= 0;
                     net->n_seam += seam;
                 }

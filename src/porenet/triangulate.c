@@ -143,44 +143,6 @@ static int triangulate_once(const pn_domain_t *dom, int n, const double *x, cons
  * the hydrostatic pressure, and only the facets they share with the pores of
  * the packing matter.
  * Returns the smallest margin meeting the condition for all of them. */
-/* The clear fluid (dom->clear_h): the tetrahedra whose power radius exceeds
- * clear_h (they are orthogonal to a sphere that could hold a grain: outside
- * the packing, the α-shape criterion), connected through such tetrahedra to
- * the rim of the triangulated cloud (a facet without a neighbour): the clear
- * fluid above and ahead of a packing reaches the rim (no images beyond the
- * packing's free surface), a large void enclosed in the packing does not and
- * stays a pore. */
-static void mark_clear(const pn_domain_t *dom, pn_tri_t *t)
-{
-    if (!(dom->clear_h > 0)) return;
-    const int nt = t->ntet;
-    unsigned char *big = malloc((size_t)nt + 1);
-    int *stack = malloc(((size_t)nt + 1) * sizeof *stack), ns = 0;
-    t->clear = calloc((size_t)nt + 1, 1);
-    for (int k = 0; k < nt; k++) {
-        const int v = t->tet[4 * k];
-        const double *P = t->P + 3 * k, *c = t->x + 3 * (size_t)v;
-        const double w = (P[0] - c[0]) * (P[0] - c[0]) + (P[1] - c[1]) * (P[1] - c[1]) + (P[2] - c[2]) * (P[2] - c[2]) -
-                         t->r[v] * t->r[v];
-        big[k] = w > dom->clear_h * dom->clear_h;
-    }
-    for (int k = 0; k < nt; k++) {
-        if (!big[k]) continue;
-        int rim = 0;
-        for (int f = 0; f < 4; f++) rim |= t->nbr[4 * k + f] < 0;
-        if (rim) t->clear[k] = 1, stack[ns++] = k;
-    }
-    while (ns > 0) {
-        const int k = stack[--ns];
-        for (int f = 0; f < 4; f++) {
-            const int u = t->nbr[4 * k + f];
-            if (u >= 0 && big[u] && !t->clear[u]) t->clear[u] = 1, stack[ns++] = u;
-        }
-    }
-    free(big);
-    free(stack);
-}
-
 static int clear_tet(const pn_tri_t *t, int k) { return t->clear && t->clear[k]; }
 
 static double needed_margin(const pn_domain_t *dom, const pn_tri_t *t, double rmax)
@@ -465,7 +427,7 @@ static int triangulate_once(const pn_domain_t *dom, int n, const double *x, cons
     t->img = IMG;
 
     const int rc = kind == PN_TRI_CGAL ? tets_cgal(t, err, nerr) : tets_qhull(dom, t, margin, err, nerr);
-    if (rc == 0) mark_clear(dom, t);
+    if (rc == 0) pn_mark_clear(dom, t);
     return rc;
 }
 
