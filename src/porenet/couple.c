@@ -24,7 +24,7 @@ void pn_model_gather(pn_model_t *m, const dem_t *d)
             if (m->dom.periodic[a]) {
                 const double L = m->dom.hi[a] - m->dom.lo[a];
                 if (v < m->dom.lo[a]) v += L;
-                else if (v >= m->dom.hi[a]) v -= L;
+                else if (v > m->dom.hi[a]) v -= L;
             }
             m->xid[3 * k + a] = v;
         }
