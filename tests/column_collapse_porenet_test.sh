@@ -14,7 +14,8 @@
 #     dense extreme and of the loose positive peak (the full runs to 0.6 s: README.md);
 #  3. restart = uninterrupted run with the clear fluid and the probes: 60 coupled steps of the loose
 #     column straight and 30 + --restart + 30 give bit-identical particles, pore pressures and
-#     series rows.
+#     series rows;
+#  4. a velocity probe with the pore network is bad input (exit 2, the key named).
 # 34-47 s wall (21-22 s CPU) on the shared 2 cores.
 . "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_collapse_pn.XXXXXX)
@@ -85,4 +86,10 @@ if [ $rc = 0 ]; then
     cmp -s $T/a.csv $T/b.csv && [ "$(wc -l <$T/a.csv)" = $H ] || { bad=1; echo "# series rows differ after the restart"; }
 fi
 report $bad "loose column: restarted particles, pore pressures and series rows (probes) bit-identical"
+
+# 4. bad input: a velocity probe in the network
+$BIN run $C/porenet_coarse_loose.ini --set probes.velocity=true --out $T/bad >$T/bad.log 2>&1
+rc=$?
+[ $rc = 2 ] && grep -q "probes.velocity: the pore network has one pressure per pore" $T/bad.log
+report $? "probes.velocity = true with the pore network: refused (exit $rc, the key named)"
 tap_end $T
