@@ -49,7 +49,13 @@ typedef struct {
     pn_bc_t bc[6];      /* flow condition of each wall face */
     double bc_value[6]; /* PN_BC_PRESSURE: pressure (Pa); PN_BC_FLUX: volume flux INTO the domain (m³/s) */
     double grad[3];     /* periodic axes: imposed mean pressure gradient ∇p (Pa/m) */
+    double clear_h;     /* > 0: pores whose power radius exceeds this (m), connected through such pores to the
+                           outside of the packing, are clear fluid at the hydrostatic pressure
+                           (dirichlet = PN_CLEAR; pn_tri_t.clear); 0: off (porenet.clear_fluid_radius) */
 } pn_domain_t;
+
+/* net->dirichlet of a clear-fluid pore (the other Dirichlet pores hold the face 0..5 of their value). */
+#define PN_CLEAR 6
 
 /* ---- regular triangulation (triangulate.c) ---------------------------------- */
 
@@ -72,6 +78,8 @@ typedef struct {
     double margin;      /* width of the image layer */
     double margin_needed; /* the width the tetrahedra of the box need (≤ margin) */
     int n_flat;         /* lower facets whose tetrahedron is flat (power centre from the hyperplane) */
+    unsigned char *clear; /* ntet: tetrahedron of the clear fluid (dom->clear_h): power radius above clear_h and
+                             connected through such tetrahedra to the rim of the cloud (NULL: none) */
 } pn_tri_t;
 
 /* Regular triangulation of n spheres (x: 3n, r: n) in the domain.  Returns 0,
@@ -88,6 +96,13 @@ typedef enum { PN_TRI_CGAL = 0, PN_TRI_QHULL } pn_tri_kind_t;
 int pn_triangulate_with(const pn_domain_t *dom, int n, const double *x, const double *r, double margin,
                         pn_tri_kind_t kind, pn_tri_t *t, char *err, size_t nerr);
 void pn_tri_free(pn_tri_t *t);
+/* The clear fluid (clear.c): t->clear, the tetrahedra whose power radius exceeds
+ * dom->clear_h connected through such tetrahedra to the rim of the cloud (left
+ * NULL when dom->clear_h is 0; pn_triangulate calls it). */
+void pn_mark_clear(const pn_domain_t *dom, pn_tri_t *t);
+/* The pore (of np, their power centres cP + 3 root[k]) nearest to point P
+ * brought into the box along the periodic axes, pore `skip` excluded (clear.c). */
+int pn_nearest_pore(const pn_domain_t *dom, const double *cP, const int *root, int np, int skip, const double P[3]);
 /* Position of extended point `p` for sphere positions x (images follow their sphere). */
 void pn_tri_point(const pn_domain_t *dom, const pn_tri_t *t, const double *x, int p, double out[3]);
 
@@ -141,6 +156,9 @@ typedef struct {
     double void_sum, solid_area_sum; /* Σ w φ_ij, Σ w γ_ij (partition checks) */
     double box_volume, solid_volume; /* box volume; Σ (4/3)π r³ of the spheres */
     int n_negative_area;             /* facets whose fluid area was ≤ 0 (overlaps) */
+    int n_seam;                      /* with the clear fluid: neighbours across a periodic face that are no pore of
+                                        the box (a period narrower than the image layer the pores need), taken
+                                        as the pore of the box nearest to their power centre */
 } pn_net_t;
 
 /* Build the network of a triangulation for sphere positions x / radii r.  0; -2 when a pore of
@@ -217,6 +235,7 @@ typedef struct {
     double margin;      /* image layer (0: auto) */
     int margin_warned;  /* warned once: 1 the given margin was widened, 2 some pores need more than the widest */
     double margin_used; /* the width of the last triangulation (the next one starts from it) */
+    double clear_radius; /* porenet.clear_fluid_radius: dom.clear_h in mean diameters of the spheres (0: off) */
     double rho_f;       /* fluid density (Reynolds number, buoyancy) */
     int n;
     pn_tri_t tri;
@@ -259,6 +278,14 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r);
  * x during dt (dt <= 0 or first call: rigid skeleton, no volume change).
  * Re-triangulates when due, solves, computes m->f.  0 or -1 (m->err). */
 int pn_model_step(pn_model_t *m, int n, const double *x, const double *r, double dt);
+/* The pore whose tetrahedra hold point y at the positions of the last step
+ * (a point of the box; its periodic copies and mirror images across the walls
+ * are tried too): the pressure there
+ * is m->p of that pore (pressure probes); PN_CLEAR_AT (with the clear fluid
+ * on): a tetrahedron of the clear fluid that is no pore of the box, or no
+ * tetrahedron (beyond the cloud of spheres and images): hydrostatic; -1: none. */
+#define PN_CLEAR_AT (-2)
+int pn_model_pore_at(const pn_model_t *m, const double y[3]);
 void pn_model_free(pn_model_t *m);
 /* The model's exact state in an HDF5 group of a checkpoint (state.c): the
  * positions of the last triangulation, the previous positions and pore

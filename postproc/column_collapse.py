@@ -4,7 +4,8 @@ pressure, the front and the horizontal kinetic energy of a run of cases/column_c
 
 usage: column_collapse.py RUN_DIR R0 [SMOOTH]
   RUN_DIR  output folder of an ibmdem run of the collapse (series.csv with the p_probeN
-           columns, particles_*.h5, fields_00000.h5, input.ini)
+           columns, particles_*.h5, input.ini; fields_00000.h5 with the resolved fluid, none
+           with the pore network, whose viscosity and density are those of [porenet])
   R0       the column's length (m; the gate's position)
   SMOOTH   width of the moving average of the basal pressure (s, default 0.02)
 Prints one line "column: key=value ..." and writes RUN_DIR/column.json.
@@ -59,9 +60,12 @@ def main():
     smooth = float(sys.argv[3]) if len(sys.argv) > 3 else 0.02
     ini = configparser.ConfigParser(inline_comment_prefixes=(";", "#"), strict=False)
     ini.read(os.path.join(d, "input.ini"))
-    rho = float(ini.get("fluid", "rho", fallback="1"))
-    nu = float(ini.get("fluid", "nu"))
-    eta = rho * nu
+    if ini.has_section("fluid"):
+        rho = float(ini.get("fluid", "rho", fallback="1"))
+        eta = rho * float(ini.get("fluid", "nu"))
+    else:  # the pore network
+        rho = float(ini.get("porenet", "fluid_density", fallback="1000"))
+        eta = float(ini.get("porenet", "viscosity"))
     snaps = sorted(glob.glob(os.path.join(d, "particles_*.h5")))
     t0, x, v, r, rp, fixed = load(snaps[0])
     mob = ~fixed
@@ -71,13 +75,18 @@ def main():
     m = mass.mean()
     drho = rp.mean() - rho
     H0 = column_height(x, r, R0)
-    with h5py.File(os.path.join(d, "fields_00000.h5"), "r") as f:
-        yf, xc, zc = f["y"][...], f["xc"][...], f["zc"][...]
-        W = yf[-1] - yf[0]
-        alpha = f["solid_fraction"][...]  # [nz][ny][nx]
-    ix = (xc > 2 * D) & (xc < R0 - 2 * D)
-    iz = (zc > 1.5 * D) & (zc < H0 - 1.5 * D)
-    phi_alpha = float(alpha[np.ix_(iz, np.ones(alpha.shape[1], bool), ix)].mean())
+    fields = os.path.join(d, "fields_00000.h5")
+    if os.path.exists(fields):
+        with h5py.File(fields, "r") as f:
+            yf, xc, zc = f["y"][...], f["xc"][...], f["zc"][...]
+            alpha = f["solid_fraction"][...]  # [nz][ny][nx]
+        ix = (xc > 2 * D) & (xc < R0 - 2 * D)
+        iz = (zc > 1.5 * D) & (zc < H0 - 1.5 * D)
+        phi_alpha = float(alpha[np.ix_(iz, np.ones(alpha.shape[1], bool), ix)].mean())
+    else:  # the pore network: no grid (the box of [domain])
+        L = [float(v) for v in ini.get("domain", "length").split()]
+        yf, phi_alpha = np.array([0.0, L[1]]), float("nan")
+    W = yf[-1] - yf[0]
     if glob.glob(os.path.join(d, "*packing*.h5")):
         phi_alpha = float("nan")  # the t = 0 snapshot of the fluid precedes [packing] prepare
     # the same box, exact sphere volumes (Monte Carlo, 2e5 points, sd ~ 0.001)

@@ -184,6 +184,13 @@ static void ensure_started(porenet_part_t *pp)
         "factorisation %.3g s\n",
         pp->n, pp->m.net.npore, (double)pp->m.net.npore / pp->n, pp->m.net.nthroat, pp->m.t_tri, pp->m.t_net,
         pp->m.t_factor);
+    if (pp->m.dom.clear_h > 0) {
+        int nc = 0;
+        for (int i = 0; i < pp->m.net.npore; i++) nc += pp->m.net.dirichlet[i] == PN_CLEAR;
+        msg("porenet: %d pores of the clear fluid (power radius above %g m = porenet.clear_fluid_radius mean "
+            "diameters, connected to the outside of the packing): hydrostatic; %d neighbours across a periodic face "
+            "taken as the nearest pore of the box\n", nc, pp->m.dom.clear_h, pp->m.net.n_seam);
+    }
     if (pp->with_dem)
         msg("porenet: coupled with the DEM, viscous step limit %.4g s (DEM step %.4g s)\n", pn_coupled_dt(&pp->m, pp->d),
             dem_dt(pp->d));
@@ -364,6 +371,14 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
     io_summary_long(y, KEY("%s.throats", prefix), m->net.nthroat);
     io_summary_long(y, KEY("%s.triangulations", prefix), m->n_retri);
     io_summary_long(y, KEY("%s.coupled_steps", prefix), m->n_steps);
+    if (m->dom.clear_h > 0) {
+        /* the last network: its clear-fluid pores and its neighbours across a periodic face taken as the
+         * nearest pore of the box (network.c) */
+        long nc = 0;
+        for (int i = 0; i < m->net.npore; i++) nc += m->net.dirichlet[i] == PN_CLEAR;
+        io_summary_long(y, KEY("%s.clear_pores", prefix), nc);
+        io_summary_long(y, KEY("%s.seam_neighbours", prefix), m->net.n_seam);
+    }
     if (m->kept_count > 0) {
         /* re-meshing: the mean and smallest fraction of a new triangulation's tetrahedra of the box that
          * the one it replaced had */

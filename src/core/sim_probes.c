@@ -7,8 +7,10 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "fluid.h"
+#include "porenet.h"
 #include "probes.h"
 #include "sim.h"
 #include "util.h"
@@ -71,10 +73,72 @@ static void part_destroy(void *ctx)
     free(pp);
 }
 
+/* ---- the pore network: the pressure of the pore holding each point ---- */
+
+typedef struct {
+    pn_model_t *m;
+    int n, ref;
+    double pts[3 * (PROBES_MAX + 1)];
+    char names[PROBES_MAX][24];
+    const char *col[PROBES_MAX];
+} pn_probes_t;
+
+static double pn_probe_value(const pn_probes_t *pp, int i)
+{
+    if (!pp->m->built) return 0.0; /* before the first solve the fluid is at rest: hydrostatic */
+    const int p = pn_model_pore_at(pp->m, pp->pts + 3 * i);
+    return p >= 0 ? pp->m->p[p] : p == PN_CLEAR_AT ? 0.0 : NAN;
+}
+
+static void pn_part_diagnostics(void *ctx, double *c)
+{
+    pn_probes_t *pp = ctx;
+    const double p0 = pp->ref ? pn_probe_value(pp, pp->n) : 0.0;
+    for (int i = 0; i < pp->n; i++) c[i] = pn_probe_value(pp, i) - p0;
+}
+
+static void add_porenet_probes(sim_t *s, cfg_t *cfg, pn_model_t *m, const double *pts, const int *key_of, int n)
+{
+    if (cfg_bool(cfg, "probes", "velocity"))
+        cfg_fail(cfg, "probes", "velocity", "the pore network has one pressure per pore and no velocity field");
+    pn_probes_t *pp = xcalloc(1, sizeof *pp);
+    pp->m = m;
+    pp->n = n;
+    pp->ref = cfg_has(cfg, "probes", "reference");
+    memcpy(pp->pts, pts, 3 * (size_t)(n + pp->ref) * sizeof *pts);
+    for (int i = 0; i < n + pp->ref; i++) {
+        const double *q = pts + 3 * i;
+        int in = 1;
+        for (int a = 0; a < 3; a++) in &= q[a] >= m->dom.lo[a] && q[a] <= m->dom.hi[a];
+        char key[32];
+        if (i < n) snprintf(key, sizeof key, "point%d", key_of[i]);
+        else snprintf(key, sizeof key, "reference");
+        if (!in)
+            cfg_fail(cfg, "probes", key, "the point (%g, %g, %g) is outside the domain, x in [%g, %g], y in [%g, %g], "
+                     "z in [%g, %g]", q[0], q[1], q[2], m->dom.lo[0], m->dom.hi[0], m->dom.lo[1], m->dom.hi[1],
+                     m->dom.lo[2], m->dom.hi[2]);
+        if (i < n) {
+            snprintf(pp->names[i], sizeof pp->names[0], "p_probe%d", key_of[i]);
+            pp->col[i] = pp->names[i];
+        }
+        msg("probes: %s (%g, %g, %g), the pressure of the pore holding it\n", i < n ? pp->names[i] : "reference",
+            q[0], q[1], q[2]);
+    }
+    sim_part_t part = {
+        .name = "probes",
+        .ctx = pp,
+        .ncol = n,
+        .col_names = pp->col,
+        .diagnostics = pn_part_diagnostics,
+        .destroy = free,
+    };
+    sim_add_part(s, &part);
+}
+
 void sim_add_probes(sim_t *s, cfg_t *cfg)
 {
-    if (!s->fluid) die("probes: the scene has no resolved fluid");
-    const grid_t *g = s->fluid->g;
+    pn_model_t *pm = s->fluid ? NULL : sim_porenet_model(s);
+    if (!s->fluid && !pm) die("probes: the scene has no resolved fluid and no pore network");
     double pts[3 * (PROBES_MAX + 1)];
     int key_of[PROBES_MAX + 1], n = 0;
     for (int k = 1; k <= PROBES_MAX; k++) {
@@ -85,6 +149,12 @@ void sim_add_probes(sim_t *s, cfg_t *cfg)
         key_of[n++] = k;
     }
     if (n == 0) cfg_fail(cfg, "probes", "point1", "the [probes] section names no point (point1 ... point9)");
+    if (pm) {
+        if (cfg_has(cfg, "probes", "reference")) cfg_vec3(cfg, "probes", "reference", pts + 3 * n);
+        add_porenet_probes(s, cfg, pm, pts, key_of, n);
+        return;
+    }
+    const grid_t *g = s->fluid->g;
     probes_part_t *pp = xcalloc(1, sizeof *pp);
     pp->f = s->fluid;
     pp->n = n;

@@ -3,12 +3,13 @@
  *
  *   resolved     fluid; with particles: DEM (driven), immersed spheres of the
  *                particles (after those of [ibm]), coupling; without: [ibm] if given;
- *                then the probes of [probes] (not read by the other models: the
- *                log notes their keys as unused)
- *   porenet      DEM (if particles), pore network
+ *                then the probes of [probes]
+ *   porenet      DEM (if particles), pore network, the probes of [probes] (the
+ *                pressure of the pore holding each point)
  *   drag,
  *   lubrication,
- *   none         DEM (the drag, the buoyancy and the lubrication act inside its steps)
+ *   none         DEM (the drag, the buoyancy and the lubrication act inside its steps);
+ *                [probes] is not read (the log notes its keys as unused)
  * plus, without the resolved fluid, the restitution measurements if asked. */
 #include <stdlib.h>
 #include <string.h>
@@ -48,6 +49,7 @@ void sim_build_scene(sim_t *s, cfg_t *cfg)
     if (particles) sim_add_dem(s, cfg);
     if (model == FLUID_MODEL_PORENET) sim_add_porenet(s, cfg);
     if (model == FLUID_MODEL_PORENET && cfg_has_section(cfg, "oedometer")) sim_add_oedometer(s, cfg);
+    if (model == FLUID_MODEL_PORENET && cfg_has_section(cfg, "probes")) sim_add_probes(s, cfg);
     if (particles && cfg_enum(cfg, "coupling", "restitution") != 0) sim_add_coupling(s, cfg, NULL);
     if (particles && cfg_has_section(cfg, "avalanche")) sim_add_avalanche(s, cfg, NULL);
     if (s->npart == 0) {

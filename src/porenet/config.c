@@ -47,6 +47,10 @@ static const cfg_key_t porenet_keys[] = {
     {"porenet", "margin", CFG_DOUBLE, "0", 0, BIG, NULL,
      "width of the layer of sphere images across the faces (m); 0: 2.75 largest radii; widened (with a warning "
      "when given) to what the pores of the box need: a narrower layer would lose or change pores"},
+    {"porenet", "clear_fluid_radius", CFG_DOUBLE, "0", 0, 100, NULL,
+     "pores of the clear fluid outside a packing that does not fill the box: a pore whose power radius exceeds "
+     "this many mean diameters holds the hydrostatic pressure (a reservoir: excess pressure 0); 0: off (every "
+     "pore is solved for)"},
     {"porenet", "packing", CFG_STRING, NULL, 1, 0, NULL,
      "fixed packing when the scene has no DEM particles ([particles]): text (x y z r per line, # comments) "
      "or HDF5 (.h5: datasets position [n][3] and radius, the layout of ibm.spheres_file)"},
@@ -112,6 +116,7 @@ void pn_model_from_config(cfg_t *cfg, pn_model_t *m)
     m->pcg_tol = cfg_double(cfg, "porenet", "pcg_tol");
     m->eps_retri = cfg_double(cfg, "porenet", "retriangulate");
     m->margin = cfg_double(cfg, "porenet", "margin");
+    m->clear_radius = cfg_double(cfg, "porenet", "clear_fluid_radius");
     m->dt_factor = cfg_double(cfg, "porenet", "dt_factor");
     m->dem_steps = cfg_int(cfg, "porenet", "dem_steps");
 }

@@ -18,7 +18,16 @@ void pn_model_gather(pn_model_t *m, const dem_t *d)
     }
     for (int i = 0; i < n; i++) {
         const long k = id[i];
-        for (int a = 0; a < 3; a++) m->xid[3 * k + a] = x[3 * i + a];
+        for (int a = 0; a < 3; a++) {
+            double v = x[3 * i + a];
+            /* the DEM brings a centre back across a periodic face at its own pace (list updates) */
+            if (m->dom.periodic[a]) {
+                const double L = m->dom.hi[a] - m->dom.lo[a];
+                if (v < m->dom.lo[a]) v += L;
+                else if (v > m->dom.hi[a]) v -= L;
+            }
+            m->xid[3 * k + a] = v;
+        }
         m->rid[k] = r[i];
     }
 }

@@ -89,8 +89,8 @@ void pn_face_fluxes(const pn_domain_t *dom, const pn_net_t *net, const double *p
         int fi = net->dirichlet[i], fj = net->dirichlet[j];
         if (fi == fj) continue; /* both interior, or both on the same reservoir */
         double qq = net->k[th] * pn_throat_dp(dom, net, p, th); /* from i to j */
-        if (fi >= 0) q[fi] += qq;
-        if (fj >= 0) q[fj] -= qq;
+        if (fi >= 0 && fi < 6) q[fi] += qq; /* PN_CLEAR: the clear fluid is no face */
+        if (fj >= 0 && fj < 6) q[fj] -= qq;
     }
 }
 

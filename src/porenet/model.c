@@ -114,6 +114,11 @@ int pn_model_rebuild(pn_model_t *m, int n, const double *x, const double *r)
      * the box that still reaches the rim of the cloud (the criterion of the triangulation can miss
      * the large power spheres of a sphere-free layer at a face) widens the layer by half, up to the
      * box's length, and the triangulation is made again */
+    if (m->clear_radius > 0) {
+        double dsum = 0;
+        for (int i = 0; i < n; i++) dsum += 2 * r[i];
+        m->dom.clear_h = m->clear_radius * dsum / n;
+    }
     double mg = m->margin > 0 ? m->margin : m->margin_used, mcap = INFINITY;
     for (int a = 0; a < 3; a++) mcap = fmin(mcap, 0.999 * (m->dom.hi[a] - m->dom.lo[a]));
     for (int attempt = 0;; attempt++) {
@@ -290,7 +295,8 @@ int pn_model_validity(const pn_model_t *m, const double *r, char *buf, size_t nb
         umax = fmax(umax, fabs(q) / m->net.area[f]);
     }
     double vv = 0, vt = 0;
-    for (int i = 0; i < m->net.npore; i++) vv += m->net.vvoid[i], vt += m->net.vol[i];
+    for (int i = 0; i < m->net.npore; i++)
+        if (m->net.dirichlet[i] != PN_CLEAR) vv += m->net.vvoid[i], vt += m->net.vol[i]; /* the packing's */
     *re = m->rho_f * umax * 2 * rmean / m->prm.mu;
     *size_ratio = rmin / rmean;
     *porosity = vt > 0 ? vv / vt : NAN;
@@ -311,4 +317,55 @@ int pn_model_validity(const pn_model_t *m, const double *r, char *buf, size_t nb
         ADD("porosity %.3g outside 0.25-0.5: the pore network is meant for dense packings\n", *porosity);
 #undef ADD
     return nw;
+}
+
+/* Is y inside the tetrahedron a b c d (barycentric signs, boundary included)? */
+static int in_tet(const double *a, const double *b, const double *c, const double *d, const double *y)
+{
+    const double *v[4] = {a, b, c, d};
+    double s0 = 0;
+    for (int k = 0; k < 4; k++) {
+        const double *p[4] = {v[0], v[1], v[2], v[3]};
+        p[k] = y; /* the volume with vertex k replaced by y: the same sign as the tetrahedron's inside */
+        const double e1[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]},
+                     e2[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]},
+                     e3[3] = {p[3][0] - p[0][0], p[3][1] - p[0][1], p[3][2] - p[0][2]};
+        const double s = e1[0] * (e2[1] * e3[2] - e2[2] * e3[1]) - e1[1] * (e2[0] * e3[2] - e2[2] * e3[0]) +
+                         e1[2] * (e2[0] * e3[1] - e2[1] * e3[0]);
+        if (s == 0) continue;
+        if (s0 == 0) s0 = s;
+        else if ((s > 0) != (s0 > 0)) return 0;
+    }
+    return s0 != 0;
+}
+
+int pn_model_pore_at(const pn_model_t *m, const double y[3])
+{
+    const pn_net_t *net = &m->net;
+    if (!m->built || !net->ntets || !m->x_prev) return -1; /* a failed rebuild leaves no network */
+    /* the point and its copies: a pore of the box may extend across a periodic face, and a
+     * tetrahedron of the box whose power centre is beyond a wall is the mirror of a pore's */
+    for (int s = 0; s < 27; s++) {
+        const int sh[3] = {s % 3 - 1, (s / 3) % 3 - 1, s / 9 - 1};
+        double z[3];
+        for (int a = 0; a < 3; a++) {
+            const double lo = m->dom.lo[a], hi = m->dom.hi[a];
+            z[a] = sh[a] == 0 ? y[a] : m->dom.periodic[a] ? y[a] + sh[a] * (hi - lo) : sh[a] < 0 ? 2 * lo - y[a] : 2 * hi - y[a];
+        }
+        for (int p = 0; p < net->npore; p++)
+            for (int q = net->ntets[p]; q < net->ntets[p + 1]; q++) {
+                double v[4][3];
+                for (int k = 0; k < 4; k++) pn_tri_point(&m->dom, &m->tri, m->x_prev, net->tetv[4 * q + k], v[k]);
+                if (in_tet(v[0], v[1], v[2], v[3], z)) return p;
+            }
+    }
+    /* a tetrahedron of the clear fluid that is no pore of the box (its power centre beyond a face) */
+    for (int k = 0; k < m->tri.ntet && m->dom.clear_h > 0; k++) {
+        double v[4][3];
+        for (int q = 0; q < 4; q++) pn_tri_point(&m->dom, &m->tri, m->x_prev, m->tri.tet[4 * k + q], v[q]);
+        if (!in_tet(v[0], v[1], v[2], v[3], y)) continue;
+        return m->tri.clear && m->tri.clear[k] ? PN_CLEAR_AT : -1;
+    }
+    /* outside the triangulated cloud (spheres and images): beyond the packing, in the clear fluid */
+    return m->dom.clear_h > 0 ? PN_CLEAR_AT : -1;
 }

@@ -309,6 +309,13 @@ static void wall_throats_yade(const pn_domain_t *dom, const pn_params_t *prm, co
     free(key);
 }
 
+/* A tetrahedron of the clear fluid (pn_tri_t.clear, triangulate.c). */
+static int tet_clear(const pn_domain_t *dom, const pn_tri_t *t, int tt)
+{
+    (void)dom;
+    return t->clear && t->clear[tt];
+}
+
 int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tri_t *t, const double *x,
                      const double *r, int n, pn_net_t *net, char *err, size_t nerr)
 {
@@ -478,10 +485,18 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
     int *canon = malloc((size_t)nt * sizeof *canon); /* root -> pore, or -2 unknown */
     for (int c = 0; c < nt; c++) canon[c] = pore_of[c] >= 0 ? pore_of[c] : -2;
     int status = 0;
+    /* a clear-fluid pore (dom->clear_h) holds the hydrostatic pressure, as every other: a neighbour of the
+     * packing in the clear fluid whose periodic copy is not a pore of the box (the image layer is not
+     * meant to make the clear fluid's pores exact) is any of them */
+    int any_clear = -1;
+    for (int pi = 0; pi < np && any_clear < 0 && dom->clear_h > 0; pi++)
+        if (tet_clear(dom, t, clist[cstart[proot[pi]]])) any_clear = pi;
     for (int pi = 0; pi < np && !status; pi++) {
         int c = proot[pi];
         for (int q = cstart[c]; q < cstart[c + 1] && !status; q++) {
             int tt = clist[q];
+            /* the facets of the clear fluid with the packing are the packing pores' throats */
+            const int clear_i = tet_clear(dom, t, tt);
             for (int k = 0; k < 4; k++) {
                 int u = t->nbr[4 * tt + k];
                 if (u < 0) {
@@ -500,14 +515,17 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
                         }
                         beyond = lo || hi;
                     }
-                    if (beyond) continue;
+                    /* a clear-fluid pore holds the hydrostatic pressure: only its facets
+                     * with the pores of the packing matter */
+                    if (beyond || tet_clear(dom, t, tt)) continue;
                     pn_fail(err, nerr, "pore %d reaches the rim of the triangulated cloud: image margin (%g) too small",
                             pi, t->margin);
                     status = -2;
                     break;
                 }
                 int nb = cl[u];
-                if (nb == c) continue;
+                if (nb == c || clear_i) continue;
+                const int clear_j = tet_clear(dom, t, u);
                 /* throat weight and the wall plane it lies in */
                 double w = 1.0;
                 int plane = -1;
@@ -539,6 +557,18 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
                     canon[nb] = found >= 0 ? found : -1;
                 }
                 int pj = canon[nb];
+                if (pj < 0 && clear_j) pj = any_clear;
+                int seam = 0;
+                if (pj < 0 && dom->clear_h > 0) {
+                    /* a packing that does not fill the box in a period narrower than the image layer its
+                     * pores need (the column collapse): the pore of the box nearest to the copy's power
+                     * centre brought into the box */
+                    double q[3];
+                    for (int a = 0; a < 3; a++) q[a] = cP[3 * nb + a];
+                    pj = pn_nearest_pore(dom, cP, proot, np, pi, q);
+                    seam = pj >= 0;
+                    net->n_seam += seam;
+                }
                 if (pj < 0) {
                     status = pn_fail(err, nerr, "pore %d: the periodic copy of a neighbour has no canonical pore", pi);
                     break;
@@ -547,7 +577,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
                 sub3(cP + 3 * nb, cP + 3 * c, dx);
                 /* count each facet once: from the pore with the smaller index,
                  * or, between a pore and its own periodic copy, along +shift */
-                if (pj < pi) continue;
+                if (pj < pi && !clear_j && !seam) continue;
                 if (pj == pi) {
                     double s[3];
                     sub3(cP + 3 * nb, cP + 3 * proot[pj], s);
@@ -627,6 +657,7 @@ int pn_network_build(const pn_domain_t *dom, const pn_params_t *prm, const pn_tr
                 if (dom->bc[f] == PN_BC_PRESSURE && net->dirichlet[p] < 0) net->dirichlet[p] = f;
             }
         }
+        if (net->dirichlet[p] < 0 && tet_clear(dom, t, clist[cstart[c]])) net->dirichlet[p] = PN_CLEAR;
         double vt = 0, vs = 0;
         for (int q = cstart[c], m = net->ntets[p]; q < cstart[c + 1]; q++, m++) {
             int tt = clist[q];

@@ -289,7 +289,7 @@ int pn_solve(pn_solver_t *s, const pn_domain_t *dom, const pn_net_t *net, const 
     /* imposed pressures */
     for (int i = 0; i < np; i++) {
         int f = net->dirichlet[i];
-        p[i] = f >= 0 ? dom->bc_value[f] : 0.0;
+        p[i] = f >= 0 && f < 6 ? dom->bc_value[f] : 0.0; /* PN_CLEAR: hydrostatic */
     }
     memset(s->b, 0, (size_t)nu * sizeof *s->b);
     for (int i = 0; i < np; i++) {

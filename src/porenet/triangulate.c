@@ -49,7 +49,15 @@ void pn_tri_free(pn_tri_t *t)
     free(t->P);
     free(t->cond);
     free(t->grp);
+    free(t->clear);
     memset(t, 0, sizeof *t);
+}
+
+/* A centre on the wall plane of axis a (within round-off of the box length). */
+static int on_plane(const pn_domain_t *dom, int a, double v)
+{
+    const double tol = 1e-12 * (dom->hi[a] - dom->lo[a]);
+    return fabs(v - dom->lo[a]) <= tol || fabs(dom->hi[a] - v) <= tol;
 }
 
 /* Image of coordinate v of a sphere on axis a, image index s. */
@@ -131,7 +139,12 @@ static int triangulate_once(const pn_domain_t *dom, int n, const double *x, cons
  * (their neighbours across a periodic face: the throats to them are kept,
  * and they must exist; across a wall they are mirror copies, whose throats
  * are not, network.c).
+ * The clear-fluid tetrahedra (dom->clear_h) are left out: their pores hold
+ * the hydrostatic pressure, and only the facets they share with the pores of
+ * the packing matter.
  * Returns the smallest margin meeting the condition for all of them. */
+static int clear_tet(const pn_tri_t *t, int k) { return t->clear && t->clear[k]; }
+
 static double needed_margin(const pn_domain_t *dom, const pn_tri_t *t, double rmax)
 {
     double *w = malloc(((size_t)t->ntet + 1) * sizeof *w), hin = 0;
@@ -141,7 +154,7 @@ static double needed_margin(const pn_domain_t *dom, const pn_tri_t *t, double rm
         w[k] = (P[0] - c[0]) * (P[0] - c[0]) + (P[1] - c[1]) * (P[1] - c[1]) + (P[2] - c[2]) * (P[2] - c[2]) - rr * rr;
         int in = 1;
         for (int a = 0; a < 3; a++) in &= P[a] >= dom->lo[a] && P[a] <= dom->hi[a];
-        if (in && w[k] > 0) hin = fmax(hin, sqrt(w[k]));
+        if (in && w[k] > 0 && !clear_tet(t, k)) hin = fmax(hin, sqrt(w[k]));
     }
     /* across a periodic face the neighbours of the pores of the box must exist and be exact: copies
      * of pores of the box, their power centres lie within 2 hin of the face (two power radii from a
@@ -158,7 +171,7 @@ static double needed_margin(const pn_domain_t *dom, const pn_tri_t *t, double rm
             const double h = dom->periodic[a] ? 2 * hin : 1e-8 * (dom->hi[a] - dom->lo[a]);
             near &= P[a] >= dom->lo[a] - h && P[a] <= dom->hi[a] + h;
         }
-        if (!near) continue;
+        if (!near || clear_tet(t, k)) continue;
         /* δ_a = m + (distance from P to the nearer face, negative outside) ≥ √(w + r_max²) */
         const double reach = sqrt(fmax(w[k], 0.0) + rmax * rmax);
         for (int a = 0; a < 3; a++) need = fmax(need, reach - fmin(P[a] - dom->lo[a], dom->hi[a] - P[a]));
@@ -351,8 +364,10 @@ static int triangulate_once(const pn_domain_t *dom, int n, const double *x, cons
                 return pn_fail(err, nerr, "sphere %d: centre (%g, %g, %g) outside the box", i, x[3 * i], x[3 * i + 1],
                             x[3 * i + 2]);
             /* A centre inside its own mirror image would be a hidden point
-             * (§1.2): the distance to a wall must exceed r/2. */
-            if (!dom->periodic[a] && (v - dom->lo[a] <= 0.5 * r[i] || dom->hi[a] - v <= 0.5 * r[i]))
+             * (§1.2): the distance to a wall must exceed r/2, unless the centre is on the
+             * wall plane (a half-sphere fixed on the wall: its own image, none is made). */
+            if (!dom->periodic[a] && !on_plane(dom, a, v) &&
+                (v - dom->lo[a] <= 0.5 * r[i] || dom->hi[a] - v <= 0.5 * r[i]))
                 return pn_fail(err, nerr, "sphere %d: centre closer than r/2 to a wall of axis %c (overlap with the wall)",
                             i, 'x' + a);
         }
@@ -377,6 +392,10 @@ static int triangulate_once(const pn_domain_t *dom, int n, const double *x, cons
             for (int a = 0; a < 3 && ok; a++) {
                 y[a] = image_coord(dom, a, sh[a], x[3 * i + a]);
                 if (sh[a] != 0 && !(y[a] > dom->lo[a] - margin && y[a] < dom->hi[a] + margin)) ok = 0;
+                /* a centre on a wall plane is its own mirror image across it */
+                if (sh[a] != 0 && !dom->periodic[a] && on_plane(dom, a, x[3 * i + a]) &&
+                    fabs(y[a] - x[3 * i + a]) <= 1e-12 * (dom->hi[a] - dom->lo[a]))
+                    ok = 0;
             }
             if (!ok) continue;
             if (np == cap) {
@@ -407,7 +426,8 @@ static int triangulate_once(const pn_domain_t *dom, int n, const double *x, cons
     t->id = ID;
     t->img = IMG;
 
-    if (kind == PN_TRI_CGAL) return tets_cgal(t, err, nerr);
-    return tets_qhull(dom, t, margin, err, nerr);
+    const int rc = kind == PN_TRI_CGAL ? tets_cgal(t, err, nerr) : tets_qhull(dom, t, margin, err, nerr);
+    if (rc == 0) pn_mark_clear(dom, t);
+    return rc;
 }
 
