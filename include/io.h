@@ -95,6 +95,8 @@ void io_series_close(io_series_t *s);
  * The writers below record a failed write as an I/O error (io_error) and
  * go on, so that every rank makes the same collective calls. */
 hid_t io_h5_create(const char *path, MPI_Comm comm);
+/* The same with a file-access property list of the caller's (MPI-IO). */
+hid_t io_h5_create_with(const char *path, MPI_Comm comm, hid_t fapl);
 hid_t io_h5_open(const char *path, MPI_Comm comm);
 /* Close; a file opened for writing is first flushed to the disk (fsync). */
 void io_h5_close(hid_t file);

@@ -20,13 +20,15 @@
 #include <unistd.h>
 
 #include "dem_private.h"
+#include "io.h"
 #include "util.h"
 
 static hid_t open_file(const dem_t *d, const char *path, int create)
 {
     hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
     H5Pset_fapl_mpio(fapl, d->comm, MPI_INFO_NULL);
-    hid_t f = create ? H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl) : H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    /* a creation is tried again if MPI-IO fails to open the file (io_h5_create_with) */
+    hid_t f = create ? io_h5_create_with(path, d->comm, fapl) : H5Fopen(path, H5F_ACC_RDONLY, fapl);
     H5Pclose(fapl);
     if (f < 0) die("dem: cannot %s HDF5 file %s", create ? "create" : "open", path);
     return f;

@@ -7,6 +7,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "io.h"
@@ -24,12 +25,41 @@ static hid_t fapl_mpio(MPI_Comm comm)
     return fapl;
 }
 
+/* Create (truncate) a file on every rank of comm.  Open MPI's MPI-IO open
+ * fails now and then (MPI_ERR_OTHER) when several MPI processes start and
+ * open files at once on the machine: the ranks agree whether every one has
+ * the file, and the creation is tried again, up to 5 times, 0.1-0.5 s apart,
+ * before the run stops (HDF5's error report is printed for the last try). */
+hid_t io_h5_create_with(const char *path, MPI_Comm comm, hid_t fapl)
+{
+    enum { TRIES = 5 };
+    hid_t f = -1;
+    for (int t = 0; t < TRIES; t++) {
+        if (t < TRIES - 1) {
+            H5E_BEGIN_TRY { f = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl); }
+            H5E_END_TRY;
+        } else {
+            f = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+        }
+        int ok = f >= 0, all = 0;
+        MPI_Allreduce(&ok, &all, 1, MPI_INT, MPI_MIN, comm);
+        if (all) break;
+        if (f >= 0) H5Fclose(f);
+        f = -1;
+        if (t < TRIES - 1) {
+            const struct timespec pause = {0, 100000000L * (t + 1)};
+            nanosleep(&pause, NULL);
+        }
+    }
+    if (f < 0) die("cannot create the HDF5 file %s", path);
+    return f;
+}
+
 hid_t io_h5_create(const char *path, MPI_Comm comm)
 {
     hid_t fapl = fapl_mpio(comm);
-    hid_t f = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    hid_t f = io_h5_create_with(path, comm, fapl);
     H5Pclose(fapl);
-    if (f < 0) die("cannot create the HDF5 file %s", path);
     return f;
 }
 
