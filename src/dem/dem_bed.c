@@ -105,6 +105,23 @@ static int bed_dense(const dem_t *d, int a1, int a2, double R, double poly, doub
     return worst > 1e-9 * R ? -1 : nb;
 }
 
+/* The discs of a bed as fixed grains with centres on the plane; the arrays are freed. */
+static void add_discs(dem_t *d, int ax, int a1, int a2, double pos, double rho, int nb, double *c1, double *c2,
+                      double *cr)
+{
+    const double v0[3] = {0, 0, 0};
+    for (int k = 0; k < nb; k++) {
+        double x[3];
+        x[ax] = pos;
+        x[a1] = c1[k];
+        x[a2] = c2[k];
+        dem_add_particle(d, x, v0, cr[k], rho, 1);
+    }
+    free(c1);
+    free(c2);
+    free(cr);
+}
+
 /* 2-D random, dense or hexagonal layer of fixed grains with centres on a plane. */
 void dem_config_bed(dem_t *d, cfg_t *cfg)
 {
@@ -156,16 +173,7 @@ void dem_config_bed(dem_t *d, cfg_t *cfg)
         if (nb < 0)
             cfg_fail(cfg, "bed", "coverage", "the discs of a dense bed at coverage %.3f could not be pushed apart "
                      "(a disordered monolayer jams near 0.82, earlier in a small periodic plane)", cfg_double(cfg, "bed", "coverage"));
-        for (int k = 0; k < nb; k++) {
-            double x[3];
-            x[ax] = pos;
-            x[a1] = c1[k];
-            x[a2] = c2[k];
-            dem_add_particle(d, x, v0, cr[k], rho, 1);
-        }
-        free(c1);
-        free(c2);
-        free(cr);
+        add_discs(d, ax, a1, a2, pos, rho, nb, c1, c2, cr);
         msg("dem: dense random bed of %d fixed grains (coverage %.3f) at %c = %g m\n", nb, covered / (L1 * L2),
             "xyz"[ax], pos);
         return;
@@ -237,16 +245,7 @@ void dem_config_bed(dem_t *d, cfg_t *cfg)
             cfg_fail(cfg, "bed", "coverage", "random insertion jammed at coverage %.3f (asked %.3f)", covered / area,
                      cover);
     }
-    for (int k = 0; k < nb; k++) {
-        double x[3];
-        x[ax] = pos;
-        x[a1] = c1[k];
-        x[a2] = c2[k];
-        dem_add_particle(d, x, v0, cr[k], rho, 1);
-    }
-    free(c1);
-    free(c2);
-    free(cr);
+    add_discs(d, ax, a1, a2, pos, rho, nb, c1, c2, cr);
     free(head);
     free(next);
     msg("dem: random bed of %d fixed grains (coverage %.3f) at %c = %g m\n", nb, covered / area, "xyz"[ax], pos);
