@@ -74,9 +74,10 @@ for N in $SIZES; do
             $MPIRUN -np $np "$BENCH" $data $steps ibm_$tag - $par > ibm_$tag.out 2>&1 || { echo "ibmdem failed, see $WORK/ibm_$tag.out"; exit 1; }
             echo "$phase $N $np $steps lig_$tag.out ibm_$tag.out" >> "$results"
             if [ $np -gt 1 ]; then
-                # the same with one rank and $np OpenMP threads ([dem] threads)
+                # the same with one rank and $np OpenMP threads ([dem] threads); Open MPI binds a
+                # single rank to one core unless told not to, which would put every thread on it
                 echo "dem bench: phase $phase, N = $N, 1 rank x $np threads: ibmdem"
-                $MPIRUN -np 1 "$BENCH" $data $steps ibm_${tag}t - replicated $np > ibm_${tag}t.out 2>&1 ||
+                $MPIRUN --bind-to none -np 1 "$BENCH" $data $steps ibm_${tag}t - replicated $np > ibm_${tag}t.out 2>&1 ||
                     { echo "ibmdem failed, see $WORK/ibm_${tag}t.out"; exit 1; }
                 echo "$phase $N ${np}t $steps lig_$tag.out ibm_${tag}t.out" >> "$results"
             fi

@@ -108,6 +108,10 @@ const double *dem_omegas(const dem_t *d);
 const double *dem_radii(const dem_t *d);
 const long *dem_ids(const dem_t *d);
 const unsigned char *dem_fixed(const dem_t *d);
+/* The particle indices sorted by id (a new array of dem_count + 1 ints; free it): the order the
+ * snapshots are written in, and the order in which sums over particles stay bit-identical when
+ * the DEM reorders its storage (a restart). */
+int *dem_id_order(const dem_t *d);
 double dem_mass(const dem_t *d, int i); /* inertial mass (with any added mass); +inf for a fixed particle */
 /* The particle's material density (its mass is density × volume without added mass). */
 double dem_density(const dem_t *d, int i);

@@ -24,17 +24,6 @@ static double cap_below(double R, double s)
 /* Volume of the sphere (centre c, radius R) between the heights a < b. */
 static double slab_volume(double c, double R, double a, double b) { return cap_below(R, b - c) - cap_below(R, a - c); }
 
-typedef struct {
-    long id;
-    int i;
-} id_index_t;
-
-static int cmp_id(const void *x, const void *y)
-{
-    const long a = ((const id_index_t *)x)->id, b = ((const id_index_t *)y)->id;
-    return (a > b) - (a < b);
-}
-
 void avalanche_init(avalanche_t *a, const dem_t *d, int normal_axis, double bed_plane, double zmax,
                     const double L[3], const double g[3], double rho, double eta, double bin, double t1, double t2)
 {
@@ -57,12 +46,10 @@ void avalanche_init(avalanche_t *a, const dem_t *d, int normal_axis, double bed_
     const unsigned char *fx = dem_fixed(d);
     const double *r = dem_radii(d);
     const int n = dem_count(d);
-    id_index_t *o = xcalloc((size_t)n + 1, sizeof *o);
-    for (int i = 0; i < n; i++) o[i] = (id_index_t){dem_ids(d)[i], i};
-    qsort(o, (size_t)n, sizeof *o, cmp_id);
+    int *o = dem_id_order(d);
     int nm = 0;
     for (int k = 0; k < n; k++) {
-        const int i = o[k].i;
+        const int i = o[k];
         if (fx[i]) continue;
         a->D += 2 * r[i];
         a->rho_p += dem_density(d, i);

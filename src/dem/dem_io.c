@@ -125,15 +125,15 @@ static int cmp_id_index(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static int *id_order(const dem_t *d)
+int *dem_id_order(const dem_t *d)
 {
-    id_index_t *t = malloc(((size_t)d->n + 1) * sizeof *t);
+    id_index_t *t = xcalloc((size_t)d->n + 1, sizeof *t);
     for (int i = 0; i < d->n; i++) {
         t[i].id = d->id[i];
         t[i].i = i;
     }
     qsort(t, (size_t)d->n, sizeof *t, cmp_id_index);
-    int *o = malloc(((size_t)d->n + 1) * sizeof(int));
+    int *o = xcalloc((size_t)d->n + 1, sizeof(int));
     for (int k = 0; k < d->n; k++) o[k] = t[k].i;
     free(t);
     return o;
@@ -144,7 +144,7 @@ static int *id_order(const dem_t *d)
  * bit for bit. */
 static void write_particles(dem_t *d, hid_t f, int full)
 {
-    int *o = id_order(d);
+    int *o = dem_id_order(d);
     if (full)
         for (int i = 0; i < d->n; i++) o[i] = i;
     const struct {
@@ -749,7 +749,7 @@ void dem_write_lammps_data(dem_t *d, const char *path)
     char tmp[4112];
     FILE *fp = atomic_open(path, tmp, sizeof tmp);
     if (!fp) die_local("%s", io_error_message());
-    int *o = id_order(d);
+    int *o = dem_id_order(d);
     fprintf(fp, "ibmdem DEM state at t = %.10g s\n\n%d atoms\n1 atom types\n\n", d->time, d->n);
     const char *ax = "xyz";
     for (int a = 0; a < 3; a++) fprintf(fp, "%.10g %.10g %clo %chi\n", d->lo[a], d->hi[a], ax[a], ax[a]);
