@@ -17,6 +17,11 @@
 
 typedef enum { CFG_DOUBLE, CFG_INT, CFG_BOOL, CFG_STRING, CFG_ENUM, CFG_VEC3 } cfg_type_t;
 
+/* A key without a default (def NULL): required whenever its module is part of
+ * the scene, optional (absent: not used, or a default the help states), or
+ * needed in some configurations only (the help says which). */
+typedef enum { CFG_REQUIRED = 0, CFG_OPTIONAL = 1, CFG_CONDITIONAL = 2 } cfg_need_t;
+
 typedef struct {
     const char *section;
     const char *key;
@@ -25,6 +30,7 @@ typedef struct {
     double min, max;     /* inclusive numeric range (each component for VEC3); unused if min > max */
     const char *choices; /* CFG_ENUM: "a|b|c" */
     const char *help;    /* one line */
+    cfg_need_t need;     /* def NULL: required, optional or conditional (the keys table says which) */
 } cfg_key_t;
 
 /* Sentinel-terminated tables: the last entry has section == NULL. */

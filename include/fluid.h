@@ -82,6 +82,9 @@ typedef struct {
     double dt_fixed;      /* > 0: constant time step */
     double dt_max;
     poisson_opts_t poisson;
+    int hold_flow;        /* the flow rate along the periodic direction hold_dir is held (fluid_step) */
+    int hold_dir;
+    double hold_velocity; /* ... at this superficial velocity; body_force[hold_dir] is then the drive it takes */
     int unfused;          /* verification switch, not a case-file key: every pass of the step on
                            * its own (no plane hook, divergence or correction inside the sweeps);
                            * bit-identical results (tests/test_ibm_fused.c, test_fluid_ops.c) */
@@ -159,6 +162,10 @@ double fluid_max_divergence(const fluid_t *f);
 /* Volume-weighted mean of velocity component c over the box (all ranks): along
  * a periodic direction, the flux per unit cross-section (superficial velocity). */
 double fluid_mean_velocity(const fluid_t *f, int c);
+/* prm.hold_flow: set the superficial velocity along prm.hold_dir to
+ * prm.hold_velocity by a uniform correction and add the corresponding
+ * acceleration to prm.body_force (called by fluid_step after its last stage). */
+void fluid_hold_flow_rate(fluid_t *f, double dt);
 
 /* The discrete operators, for the tests and for other modules.  u must have
  * valid ghosts (fluid_apply_bc); each writes the unknowns of out[c] only.

@@ -62,7 +62,8 @@ static void print_keys(void)
             md(k->def);
             printf("`");
         } else {
-            printf("**required**");
+            static const char *need[] = {"**required**", "optional", "if needed"};
+            printf("%s", need[k->need]);
         }
         printf(" | ");
         if (k->type == CFG_ENUM && k->choices) {

@@ -2,7 +2,11 @@
 # periodic_flow_test.sh — the periodic flow's columns (series.csv) and keys (summary.json):
 # superficial velocity, flux and Reynolds number, on plane Poiseuille flow (periodic in x and z,
 # walls in y), whose discrete steady state is known exactly, on 1 and 2 ranks; a
-# reynolds_length without a periodic direction is bad input.  Prints TAP lines.
+# reynolds_length without a periodic direction is bad input.  The held flow rate
+# ([fluid] flow_rate_direction): the superficial velocity is the target at every step, the body
+# force it reaches is the exact discrete one whatever the time step (explicit and Crank–Nicolson,
+# 1 and 2 ranks), a Reynolds-number target, restart = uninterrupted run, bad input.
+# Prints TAP lines.
 . "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_periodic_flow.XXXXXX)
 
@@ -68,4 +72,63 @@ $BIN check $T/channel.ini --set boundary.x_lo=noslip --set boundary.x_hi=noslip 
 st=$?
 [ $st = 2 ] && grep -q "fluid.reynolds_length" $T/err && grep -q "no periodic direction" $T/err
 report $? "reynolds_length in a box without a periodic direction: exit 2 ($st) with file:line: fluid.reynolds_length"
+
+# The held flow rate, from rest: superficial_u = 0.25 after every step; the body force tends to the
+# discrete steady one, f = U / (h^2/(12 nu) + dy^2/(24 nu)) (the parabola above, exact with the
+# quadratic ghost), in ~10 viscous times h^2/nu = 2 (t_end 30: the slowest mode decays as
+# exp(-pi^2 nu t/h^2), 1e-64 by then, so the tolerance 1e-10 is round-off); explicit dt = 0.002
+# (Fourier 0.34) and Crank-Nicolson dt = 0.05 (25 times the explicit limit) reach the same f.
+HOLD="--set fluid.init=rest --set fluid.body_force=0,0,0 --set fluid.flow_rate_direction=x --set fluid.superficial_velocity=0.25"
+$MPIRUN -np 1 $BIN run $T/channel.ini $HOLD --set time.t_end=30 --set fluid.dt=0.002 --out $T/h1 >$T/h1.log 2>&1 &&
+    $MPIRUN -np 2 $BIN run $T/channel.ini $HOLD --set time.t_end=30 --set fluid.dt=0.05 --set fluid.viscous=implicit \
+        --out $T/h2 >$T/h2.log 2>&1
+report $? "held flow rate: explicit on 1 rank and Crank-Nicolson on 2 ranks ran"
+$PY - $T/h1 $T/h2 <<'PY'
+import csv, json, sys
+nu, h, dy, U = 0.5, 1.0, 1.0 / 16, 0.25
+fx = U / (h * h / (12 * nu) + dy * dy / (24 * nu))
+ok = True
+for d in sys.argv[1:]:
+    rows = list(csv.DictReader(open(d + "/series.csv")))
+    s = json.load(open(d + "/summary.json"))["fluid"]
+    # every step ends at the target (round-off of a mean over 128 nodes)
+    ok = ok and all(abs(float(r["superficial_u"]) / U - 1) < 1e-13 for r in rows[1:])
+    ok = ok and abs(float(rows[-1]["body_force_x"]) / fx - 1) < 1e-10 and abs(s["body_force_x"] / fx - 1) < 1e-10
+    print("%s: f = %.15g (exact %.15g), U = %.15g" % (d, s["body_force_x"], fx, s["superficial_velocity_x"]))
+sys.exit(0 if ok else 1)
+PY
+report $? "held flow rate: superficial_u = 0.25 after every step; body_force_x = the exact discrete f to 1e-10 for dt = 0.002 (explicit) and 0.05 (Crank-Nicolson)"
+
+# a Reynolds-number target (Re = U l/nu with reynolds_length l = 0.25: Re 2 is U = 4)
+$BIN run $T/channel.ini --set fluid.init=rest --set fluid.flow_rate_direction=x --set fluid.reynolds=2 \
+    --set time.t_end=0.02 --out $T/re >$T/re.log 2>&1 &&
+    $PY -c "
+import csv, sys
+r = list(csv.DictReader(open('$T/re/series.csv')))[-1]
+sys.exit(not (abs(float(r['reynolds']) / 2 - 1) < 1e-13 and abs(float(r['superficial_u']) / 4 - 1) < 1e-13))"
+report $? "held Reynolds number: reynolds = 2 and superficial_u = Re nu/l = 4"
+
+# restart = uninterrupted run (the body force is part of the checkpoint)
+R="--set time.t_end=0.4 --set fluid.dt=0.002 --set output.checkpoint_every=100"
+$BIN run $T/channel.ini $HOLD $R --out $T/u >$T/u.log 2>&1 && cp -r $T/u $T/r && rm -f $T/r/.ibmdem.lock &&
+    $BIN run $T/channel.ini $HOLD $R --out $T/r --restart $T/r/checkpoint_00000100.h5 >$T/r.log 2>&1 &&
+    $PY tests/compare_runs.py $T/u $T/r --skip input # the copied checkpoint names the folder it was written in
+report $? "held flow rate: restarted at step 100, every output identical to the uninterrupted run's"
+
+# bad input: a held flow rate along a wall-bounded direction, without or with two targets, a target without it
+bad() { # WHAT KEY SETS...
+    local what=$1 key=$2
+    shift 2
+    $BIN check $T/channel.ini "$@" >$T/out 2>$T/err
+    local st=$?
+    [ $st = 2 ] && grep -q "^--set $key: " $T/err
+    report $? "$what: exit 2 ($st) with --set $key ($(head -1 $T/err | cut -c1-100))"
+}
+bad "flow rate held along y (walls)" fluid.flow_rate_direction --set fluid.flow_rate_direction=y --set fluid.superficial_velocity=1
+bad "flow rate held without a target" fluid.flow_rate_direction --set fluid.flow_rate_direction=x
+bad "flow rate held with two targets" fluid.flow_rate_direction --set fluid.flow_rate_direction=x \
+    --set fluid.superficial_velocity=1 --set fluid.reynolds=2
+bad "a target without flow_rate_direction" fluid.superficial_velocity --set fluid.superficial_velocity=1
+bad "a Reynolds target without reynolds_length" fluid.reynolds --set fluid.flow_rate_direction=x --set fluid.reynolds=2 \
+    --set fluid.reynolds_length=0
 tap_end $T

@@ -54,7 +54,7 @@ static const cfg_key_t coupling_keys[] = {
      "whose relaxation time is shorter than the fluid step is not driven by a stale force (docs/theory.md §9.1); "
      "0: the held force alone (the seed's)"},
     {"coupling", "restitution_axis", CFG_VEC3, NULL, -1e300, 1e300, NULL,
-     "wall: direction from the particle towards the wall (default: along gravity)"},
+     "wall: direction from the particle towards the wall (default: along gravity)", CFG_OPTIONAL},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
 };
 

@@ -10,14 +10,14 @@
 #include "sim.h"
 #include "util.h"
 
-enum { FLUID_NCOL = 5, FLUID_NCOL_MAX = FLUID_NCOL + 7 };
+enum { FLUID_NCOL = 5, FLUID_NCOL_MAX = FLUID_NCOL + 8 };
 
 typedef struct {
     sim_t *sim;
     grid_t *g;
     fluid_t *f;
     double *prev[4];      /* u, v, w, p at the start of the step (rollback) */
-    double prev_time;
+    double prev_time, prev_body_force[3];
     long prev_step;
     fluid_diag_t prev_diag; /* the diagnostics of the step before */
     int prev_stepped;
@@ -39,6 +39,7 @@ static const char *const fluid_cols[FLUID_NCOL] = {"cfl", "kinetic_energy", "div
                                                    "poisson_iterations"};
 static const char *const superficial_cols[3] = {"superficial_u", "superficial_v", "superficial_w"};
 static const char *const flux_cols[3] = {"flux_x", "flux_y", "flux_z"};
+static const char *const body_force_cols[3] = {"body_force_x", "body_force_y", "body_force_z"};
 
 /* The periodic flow (docs/user-guide.md): along each periodic direction d the
  * superficial velocity U_d (the box mean of u_d) and the flux U_d V/L_d through
@@ -56,6 +57,8 @@ static int periodic_flow(const fluid_part_t *fp, double *c)
         u2 += U * U;
     }
     if (fp->nper && fp->re_length > 0) c[n++] = sqrt(u2) * fp->re_length / fp->f->prm.nu;
+    /* a held flow rate: the body force that drives it */
+    if (fp->f->prm.hold_flow) c[n++] = fp->f->prm.body_force[fp->f->prm.hold_dir];
     return n;
 }
 
@@ -164,6 +167,7 @@ static void part_keep_previous(void *ctx)
         field_copy(fp->g, fp->prev[c], src);
     }
     fp->prev_time = f->time;
+    memcpy(fp->prev_body_force, f->prm.body_force, sizeof fp->prev_body_force);
     fp->prev_step = f->step;
     fp->prev_diag = f->diag;
     fp->prev_stepped = fp->stepped;
@@ -179,6 +183,7 @@ static void part_restore_previous(void *ctx)
         if (dst && fp->prev[c]) field_copy(fp->g, dst, fp->prev[c]);
     }
     f->time = fp->prev_time;
+    memcpy(f->prm.body_force, fp->prev_body_force, sizeof fp->prev_body_force);
     f->step = fp->prev_step;
     f->diag = fp->prev_diag;
     fp->stepped = fp->prev_stepped;
@@ -234,6 +239,8 @@ static void part_checkpoint_write(void *ctx, hid_t grp)
     const double diag[5] = {fp->stepped, f->diag.cfl, f->diag.div_max, f->diag.res_poisson, f->diag.it_poisson};
     io_h5_write_array(grp, "last_step_diagnostics", 5, diag);
     io_h5_attr_long(grp, "implicit_steps", f->implicit_steps);
+    /* the drive a held flow rate reached */
+    io_h5_write_array(grp, "body_force", 3, f->prm.body_force);
     io_h5_attr_string(grp, "layout", "interior of each staggered field, [nx][ny][nz], k fastest; "
                                      "u(i) on the high x face of cell i (CaNS convention)");
     for (int c = 0; c < 4; c++) {
@@ -317,6 +324,8 @@ static void part_checkpoint_read(void *ctx, hid_t grp, const char *path)
     if (!fp->snaps) fp->snaps = io_snapshots_create(fp->g, fp->sim->out.dir, fp->snap_first);
     io_snapshots_write_index(fp->snaps);
     if (io_h5_get_attr_long(grp, "implicit_steps", &f->implicit_steps)) f->implicit_steps = 0;
+    double bf[3];
+    if (f->prm.hold_flow && io_h5_read_array(grp, "body_force", 3, bf) == 3) memcpy(f->prm.body_force, bf, sizeof bf);
     fluid_apply_bc(f);
     fill_pressure_ghosts(fp->g, f->p);
     fp->ke_now = fluid_kinetic_energy(f);
@@ -353,7 +362,7 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
     io_summary_string(y, KEY("viscous"), visc[fp->f->prm.implicit_viscous]);
     io_summary_long(y, KEY("implicit_steps"), fp->f->implicit_steps);
     if (isfinite(fp->f->dt_viscous)) io_summary_double(y, KEY("explicit_viscous_limit"), fp->f->dt_viscous);
-    double pf[7];
+    double pf[8];
     int npf = periodic_flow(fp, pf);
     for (int m = 0; m < fp->nper; m++) {
         int dd = fp->per[m];
@@ -362,7 +371,8 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
         io_summary_double(y, KEY(name), pf[2 * m]);
         io_summary_double(y, KEY(flux_cols[dd]), pf[2 * m + 1]);
     }
-    if (npf > 2 * fp->nper) io_summary_double(y, KEY("reynolds"), pf[npf - 1]);
+    if (fp->nper && fp->re_length > 0) io_summary_double(y, KEY("reynolds"), pf[2 * fp->nper]);
+    if (fp->f->prm.hold_flow) io_summary_double(y, KEY(body_force_cols[fp->f->prm.hold_dir]), pf[npf - 1]);
 #undef KEY
 }
 
@@ -409,6 +419,7 @@ void sim_add_fluid(sim_t *s, cfg_t *cfg)
         cfg_fail(cfg, "fluid", "reynolds_length", "the Reynolds number is that of a flow periodic in some direction: "
                                                   "this domain has no periodic direction");
     if (fp->nper && fp->re_length > 0) fp->cols[ncol++] = "reynolds";
+    if (prm.hold_flow) fp->cols[ncol++] = body_force_cols[prm.hold_dir];
     sim_part_t part = {
         .name = "fluid",
         .ctx = fp,

@@ -23,7 +23,7 @@
      N == 1 ? "a probe: X Y Z (m), inside the domain; series.csv gets p_probe1 (Pa, relative to hydrostatic "  \
               "and to probes.reference if given) and with velocity = true u_probe1, v_probe1[, w_probe1]; "    \
               "point2 ... point9 the same"                                                                 \
-            : "as point1"}
+            : "as point1", CFG_OPTIONAL}
 
 static const cfg_key_t probe_keys[] = {
     POINT_KEY(1), POINT_KEY(2), POINT_KEY(3), POINT_KEY(4), POINT_KEY(5),
@@ -31,7 +31,7 @@ static const cfg_key_t probe_keys[] = {
     {"probes", "reference", CFG_VEC3, NULL, -BIG, BIG, NULL,
      "optional point (m) whose pressure is subtracted from every probe's (e.g. in the clear fluid far from the "
      "grains: the ambient pressure); without it the pressure is the solver's, whose volume-weighted mean over "
-     "the domain is zero"},
+     "the domain is zero", CFG_OPTIONAL},
     {"probes", "velocity", CFG_BOOL, "false", 1, 0, NULL, "also write the fluid velocity at each probe (m/s)"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL}};
 

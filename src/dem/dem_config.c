@@ -12,9 +12,9 @@
 #define BIG 1e300
 
 #define USER_WALL_KEYS(N)                                                                                         \
-    {"walls", "wall" #N "_point", CFG_VEC3, NULL, -BIG, BIG, NULL, "a point of extra wall " #N " (m)"},          \
+    {"walls", "wall" #N "_point", CFG_VEC3, NULL, -BIG, BIG, NULL, "a point of extra wall " #N " (m)", CFG_OPTIONAL},          \
         {"walls", "wall" #N "_normal", CFG_VEC3, NULL, -BIG, BIG, NULL,                                           \
-         "normal of extra wall " #N ", pointing to the particles' side"},                                         \
+         "normal of extra wall " #N ", pointing to the particles' side", CFG_OPTIONAL},                                         \
         {"walls", "wall" #N "_velocity", CFG_VEC3, "0 0 0", -BIG, BIG, NULL, "velocity of extra wall " #N " (m/s)"}, \
         {"walls", "wall" #N "_remove_time", CFG_DOUBLE, "-1", -1, BIG, NULL,                                      \
          "time at which extra wall " #N " is removed (s; -1: never), e.g. the gate of a column collapse"},        \
@@ -31,7 +31,7 @@ static const cfg_key_t dem_keys[] = {
     {"particles", "particle" #N, CFG_STRING, NULL, 1, 0, NULL,                                                   \
      "source = list: one particle, tagged values in any order: center X Y Z; radius R (or diameter D); "          \
      "density RHO (default particles.density); velocity U V W; omega WX WY WZ; fixed. "                           \
-     "Example: center 0 10 0 diameter 1 density 8"}
+     "Example: center 0 10 0 diameter 1 density 8", CFG_CONDITIONAL}
     PARTICLE_KEY(1), PARTICLE_KEY(2), PARTICLE_KEY(3), PARTICLE_KEY(4), PARTICLE_KEY(5), PARTICLE_KEY(6),
     PARTICLE_KEY(7), PARTICLE_KEY(8), PARTICLE_KEY(9),
     {"particles", "source", CFG_ENUM, "none", 1, 0, "none|insert|file|lammps_data|list",
@@ -39,16 +39,16 @@ static const cfg_key_t dem_keys[] = {
      "checkpoint (file), a LAMMPS data file (lammps_data)"},
     {"particles", "file", CFG_STRING, NULL, 1, 0, NULL,
      "HDF5 packing, DEM checkpoint or particle snapshot (particles_NNNNNN.h5), or LAMMPS data file to read; its "
-     "particles are the state at t = 0 of the run"},
+     "particles are the state at t = 0 of the run", CFG_CONDITIONAL},
     {"particles", "count", CFG_INT, "0", 0, 2e9, NULL, "insert: number of particles (or give volume_fraction)"},
     {"particles", "volume_fraction", CFG_DOUBLE, "0", 0, 0.45, NULL,
      "insert: solid volume fraction of the insertion region (random sequential insertion jams near 0.38)"},
-    {"particles", "radius", CFG_DOUBLE, NULL, 1e-12, BIG, NULL, "insert: mean radius (m)"},
+    {"particles", "radius", CFG_DOUBLE, NULL, 1e-12, BIG, NULL, "insert: mean radius (m)", CFG_CONDITIONAL},
     {"particles", "polydispersity", CFG_DOUBLE, "0", 0, 0.9, NULL,
      "insert: radii uniform in [R(1-p), R(1+p)] with R = radius"},
     {"particles", "density", CFG_DOUBLE, "2500", 1e-12, BIG, NULL, "particle density (kg/m^3)"},
-    {"particles", "region_lo", CFG_VEC3, NULL, -BIG, BIG, NULL, "insert: low corner of the region (default: domain)"},
-    {"particles", "region_hi", CFG_VEC3, NULL, -BIG, BIG, NULL, "insert: high corner of the region (default: domain)"},
+    {"particles", "region_lo", CFG_VEC3, NULL, -BIG, BIG, NULL, "insert: low corner of the region (default: domain)", CFG_OPTIONAL},
+    {"particles", "region_hi", CFG_VEC3, NULL, -BIG, BIG, NULL, "insert: high corner of the region (default: domain)", CFG_OPTIONAL},
     {"particles", "seed", CFG_INT, "1", 0, 2147483647, NULL, "insert: random seed"},
     {"particles", "velocity", CFG_VEC3, "0 0 0", -BIG, BIG, NULL, "insert: initial velocity (m/s)"},
     {"particles", "velocity_spread", CFG_DOUBLE, "0", 0, BIG, NULL,
@@ -59,7 +59,7 @@ static const cfg_key_t dem_keys[] = {
     {"contact", "parameters", CFG_ENUM, "restitution", 1, 0, "restitution|stiffness",
      "linear: constants from restitution and contact_time (per pair effective mass), or kn and gamma_n given"},
     {"contact", "restitution", CFG_DOUBLE, NULL, 1e-6, 1, NULL, "dry restitution coefficient e_dry"},
-    {"contact", "contact_time", CFG_DOUBLE, NULL, 1e-15, BIG, NULL, "linear: contact duration t_c (s)"},
+    {"contact", "contact_time", CFG_DOUBLE, NULL, 1e-15, BIG, NULL, "linear: contact duration t_c (s)", CFG_CONDITIONAL},
     {"contact", "calibration", CFG_ENUM, "clipped", 1, 0, "clipped|seed",
      "linear: k_n, gamma_n such that the clipped law gives exactly e_dry and t_c (clipped), or eq. 3.16-3.17 "
      "of the seed (exact for the unclipped law)"},
@@ -67,7 +67,7 @@ static const cfg_key_t dem_keys[] = {
     {"contact", "spring_kink", CFG_ENUM, "energy", 1, 0, "energy|plain",
      "linear: first and last step of a contact weighted so that velocity Verlet keeps the energy across the kink "
      "of k_n max(delta, 0) (docs/theory.md 7.7; unclipped or undamped contacts); plain: no weight"},
-    {"contact", "kn", CFG_DOUBLE, NULL, 0, BIG, NULL, "linear, parameters = stiffness: normal stiffness (N/m)"},
+    {"contact", "kn", CFG_DOUBLE, NULL, 0, BIG, NULL, "linear, parameters = stiffness: normal stiffness (N/m)", CFG_CONDITIONAL},
     {"contact", "gamma_n", CFG_DOUBLE, "0", 0, BIG, NULL,
      "linear, parameters = stiffness: normal damping per unit effective mass (1/s)"},
     {"contact", "kt_ratio", CFG_DOUBLE, "0.2", 0, 10, NULL, "linear: tangential/normal stiffness ratio k_t/k_n"},
@@ -75,7 +75,7 @@ static const cfg_key_t dem_keys[] = {
     {"contact", "wall_friction", CFG_DOUBLE, "-1", -1, 1e6, NULL, "particle-wall friction (-1: the same as friction)"},
     {"contact", "rolling_friction", CFG_DOUBLE, "0", 0, 10, NULL,
      "constant-torque rolling resistance mu_r (torque mu_r R* F_n), 0: off"},
-    {"contact", "youngs_modulus", CFG_DOUBLE, NULL, 1e-6, BIG, NULL, "hertz_mindlin: Young's modulus E (Pa)"},
+    {"contact", "youngs_modulus", CFG_DOUBLE, NULL, 1e-6, BIG, NULL, "hertz_mindlin: Young's modulus E (Pa)", CFG_CONDITIONAL},
     {"contact", "poisson_ratio", CFG_DOUBLE, "0.3", 0, 0.499, NULL, "hertz_mindlin: Poisson ratio"},
     {"contact", "reference_velocity", CFG_DOUBLE, "1", 1e-12, BIG, NULL,
      "hertz_mindlin: impact velocity of the contact time used for the time step (m/s)"},
@@ -90,7 +90,7 @@ static const cfg_key_t dem_keys[] = {
      "(random discs pushed apart until none overlaps: a disordered monolayer up to coverage ~0.8)"},
     {"bed", "axis", CFG_ENUM, "z", 1, 0, "x|y|z", "normal of the bed plane"},
     {"bed", "position", CFG_DOUBLE, "0", -BIG, BIG, NULL, "coordinate of the bed grains' centres along axis (m)"},
-    {"bed", "radius", CFG_DOUBLE, NULL, 1e-12, BIG, NULL, "mean radius of the bed grains (m)"},
+    {"bed", "radius", CFG_DOUBLE, NULL, 1e-12, BIG, NULL, "mean radius of the bed grains (m)", CFG_CONDITIONAL},
     {"bed", "polydispersity", CFG_DOUBLE, "0", 0, 0.9, NULL, "bed radii uniform in [R(1-p), R(1+p)]"},
     {"bed", "coverage", CFG_DOUBLE, "0.5", 0.01, 0.9, NULL,
      "random, dense: area fraction covered by the grains' equatorial discs (random insertion jams near 0.547, "
@@ -103,7 +103,7 @@ static const cfg_key_t dem_keys[] = {
     {"packing", "variant", CFG_ENUM, "dense", 1, 0, "dense|loose|as_is",
      "settling with no friction (dense), with loose_friction (loose), or with the run's contact law (as_is)"},
     {"packing", "loose_friction", CFG_DOUBLE, "1.0", 0, 1e6, NULL, "friction coefficient while settling a loose packing"},
-    {"packing", "gravity", CFG_VEC3, NULL, -BIG, BIG, NULL, "gravity while settling (default: dem.gravity)"},
+    {"packing", "gravity", CFG_VEC3, NULL, -BIG, BIG, NULL, "gravity while settling (default: dem.gravity)", CFG_OPTIONAL},
     {"packing", "max_time", CFG_DOUBLE, "5", 0, BIG, NULL, "longest settling time (s)"},
     {"packing", "rest_energy", CFG_DOUBLE, "1e-7", 0, BIG, NULL,
      "at rest when the kinetic energy per mobile particle < rest_energy × m g d (mean m and d)"},

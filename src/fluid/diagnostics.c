@@ -286,6 +286,29 @@ double fluid_mean_velocity(const fluid_t *f, int c)
     return vol > 0 ? sum / vol : 0.0;
 }
 
+/* Constant flow rate (fluid_params_t hold_flow, docs/theory.md §1 "Constant
+ * flow rate"): after a step the superficial velocity U along the periodic
+ * direction d is brought to the target U_t by adding Δ = U_t − U to every
+ * unknown of u_d (a uniform field: divergence-free, and it raises the mean by
+ * exactly Δ), as the mean pressure gradient Δ/Δt would over the step; the
+ * body force along d becomes f + Δ/Δt, the drive of the next step.  At a
+ * steady state Δ = 0 and f is the force the flow needs (the drag of the
+ * solid per unit fluid mass), whatever Δt. */
+void fluid_hold_flow_rate(fluid_t *f, double dt)
+{
+    const grid_t *g = f->g;
+    const int c = f->prm.hold_dir;
+    const double delta = f->prm.hold_velocity - fluid_mean_velocity(f, c);
+    int iend = fluid_iend(g, c), nj = fluid_nu(g, c, 1), nk = fluid_nu(g, c, 2);
+    for (int i = 0; i < iend; i++)
+        for (int j = 0; j < nj; j++) {
+            double *r = f->u[c] + G_IDX(g, i, j, 0);
+            for (int k = 0; k < nk; k++) r[k] += delta;
+        }
+    f->prm.body_force[c] += delta / dt;
+    fluid_apply_bc(f);
+}
+
 /* One sweep over the cells for the divergence and the convective rate (and,
  * unless the last projection gave them, one per component for the energy and
  * max |u|), two reductions. */

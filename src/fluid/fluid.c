@@ -9,13 +9,14 @@
 #include "util.h"
 
 static const cfg_key_t fluid_keys[] = {
-    {"fluid", "nu", CFG_DOUBLE, NULL, 1e-300, 1e300, NULL, "kinematic viscosity ν = η/ρ (> 0); or give mu"},
+    {"fluid", "nu", CFG_DOUBLE, NULL, 1e-300, 1e300, NULL, "kinematic viscosity ν = η/ρ (> 0); or give mu", CFG_CONDITIONAL},
     {"fluid", "mu", CFG_DOUBLE, NULL, 1e-300, 1e300, NULL,
-     "dynamic viscosity η (Pa s), instead of nu (ν = η/ρ)"},
+     "dynamic viscosity η (Pa s), instead of nu (ν = η/ρ)", CFG_CONDITIONAL},
     {"fluid", "rho", CFG_DOUBLE, "1", 1e-300, 1e300, NULL,
      "fluid density (the solver uses the kinematic pressure p/ρ; ρ scales forces and output)"},
     {"fluid", "body_force", CFG_VEC3, "0 0 0", -1e300, 1e300, NULL,
-     "uniform body acceleration (e.g. a mean pressure gradient −(dP/dx)/ρ); NOT gravity: the pressure is "
+     "uniform body acceleration (e.g. a mean pressure gradient −(dP/dx)/ρ) on the whole box, the inside of "
+     "immersed solids included (as a mean pressure gradient acts on a bed); NOT gravity: the pressure is "
      "relative to hydrostatic"},
     {"fluid", "viscous", CFG_ENUM, "auto", 1, 0, "explicit|implicit|auto",
      "viscous term: explicit in the RK3 stages, Crank–Nicolson per stage (Helmholtz solves, same method "
@@ -46,6 +47,17 @@ static const cfg_key_t fluid_keys[] = {
      "length ℓ of the Reynolds number Re = |U| ℓ/ν of a flow periodic in some direction, U the superficial "
      "velocity (the box mean of u, solid included) along the periodic directions: column reynolds of series.csv "
      "and fluid.reynolds of summary.json; 0: none"},
+    {"fluid", "flow_rate_direction", CFG_ENUM, "none", 1, 0, "none|x|y|z",
+     "hold the flow rate of a periodic flow along this periodic direction: after every step the superficial "
+     "velocity (the box mean of that component, solid included) is set to the target (superficial_velocity or "
+     "reynolds) by a uniform correction, and the body force along it becomes the one that drives the flow "
+     "(body_force is its initial value; series.csv body_force_x …, summary.json fluid.body_force_x …); none: the "
+     "body force is held"},
+    {"fluid", "superficial_velocity", CFG_DOUBLE, NULL, -1e300, 1e300, NULL,
+     "optional; flow_rate_direction: the target superficial velocity U (m/s; or give reynolds)", CFG_OPTIONAL},
+    {"fluid", "reynolds", CFG_DOUBLE, NULL, -1e300, 1e300, NULL,
+     "optional; flow_rate_direction: the target Reynolds number U ℓ/ν, ℓ = reynolds_length (instead of "
+     "superficial_velocity)", CFG_OPTIONAL},
     {"fluid", "init_abc", CFG_VEC3, "1 1 1", -1e300, 1e300, NULL, "coefficients A B C of init = abc"},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL}};
 
@@ -73,6 +85,29 @@ void fluid_params_from_config(cfg_t *cfg, const grid_t *g, fluid_params_t *prm)
     prm->dt_fixed = cfg_double(cfg, "fluid", "dt");
     prm->dt_max = cfg_double(cfg, "fluid", "dt_max");
     poisson_opts_from_config(cfg, &prm->poisson);
+    prm->hold_dir = cfg_enum(cfg, "fluid", "flow_rate_direction") - 1;
+    prm->hold_flow = prm->hold_dir >= 0;
+    if (prm->hold_flow) {
+        const int d = prm->hold_dir, sv = cfg_has(cfg, "fluid", "superficial_velocity"),
+                  re = cfg_has(cfg, "fluid", "reynolds");
+        if (d >= g->dim || !g->periodic[d])
+            cfg_fail(cfg, "fluid", "flow_rate_direction",
+                     "the flow rate is held along a periodic direction: %c is not periodic", "xyz"[d]);
+        if (sv == re)
+            cfg_fail(cfg, "fluid", "flow_rate_direction",
+                     sv ? "give superficial_velocity or reynolds, not both" : "needs superficial_velocity or reynolds");
+        if (sv)
+            prm->hold_velocity = cfg_double(cfg, "fluid", "superficial_velocity");
+        else {
+            const double ell = cfg_double(cfg, "fluid", "reynolds_length");
+            if (!(ell > 0)) cfg_fail(cfg, "fluid", "reynolds", "a target Reynolds number needs reynolds_length > 0");
+            prm->hold_velocity = cfg_double(cfg, "fluid", "reynolds") * prm->nu / ell;
+        }
+    } else {
+        if (cfg_has(cfg, "fluid", "superficial_velocity"))
+            cfg_fail(cfg, "fluid", "superficial_velocity", "needs flow_rate_direction (x, y or z)");
+        if (cfg_has(cfg, "fluid", "reynolds")) cfg_fail(cfg, "fluid", "reynolds", "needs flow_rate_direction (x, y or z)");
+    }
 
     if (g->dim == 2 && prm->body_force[2] != 0.0)
         cfg_fail(cfg, "fluid", "body_force", "a 2-D grid has no z direction: the z component must be 0");

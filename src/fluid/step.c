@@ -441,5 +441,10 @@ void fluid_step(fluid_t *f, double dt)
     f->step++;
     f->implicit_steps += impl;
     f->diag.dt = dt;
-    fluid_update_diagnostics(f, stats, is3d ? div_cfl : NULL);
+    if (f->prm.hold_flow) {
+        /* the energy, max |u| and convective rate of the projection are those before the correction */
+        fluid_hold_flow_rate(f, dt);
+        fluid_update_diagnostics(f, NULL, NULL);
+    } else
+        fluid_update_diagnostics(f, stats, is3d ? div_cfl : NULL);
 }

@@ -17,7 +17,7 @@
     "a sphere: KIND then tagged values in any order — KIND = free|fixed|prescribed; center X Y Z; radius R "     \
     "(or diameter D); density RHO (free: required); velocity U V W; omega WX WY WZ; history FILE (prescribed: "  \
     "CSV t,u,v,w[,ox,oy,oz], linear in t). Example: free center 0 10 0 diameter 1 density 4"
-#define SPHERE_KEY(N) {"ibm", "sphere" #N, CFG_STRING, NULL, 1, 0, NULL, N == 1 ? SPHERE_HELP : "as sphere1"}
+#define SPHERE_KEY(N) {"ibm", "sphere" #N, CFG_STRING, NULL, 1, 0, NULL, N == 1 ? SPHERE_HELP : "as sphere1", CFG_OPTIONAL}
 
 static const cfg_key_t ibm_keys[] = {
     {"ibm", "force_model", CFG_ENUM, "momentum", 1, 0, "momentum|rigid",
@@ -53,9 +53,9 @@ static const cfg_key_t ibm_keys[] = {
      "forcing_iterations = 0; see docs/theory.md); none: the seed's volume fraction"},
     {"ibm", "spheres_file", CFG_STRING, NULL, 1, 0, NULL,
      "many spheres: a CSV file (header with x,y,z,radius or diameter; optional density,u,v,w,ox,oy,oz,kind or "
-     "fixed) or an HDF5 packing (.h5: datasets position [n][3], radius; optional density, velocity, omega, fixed)"},
+     "fixed) or an HDF5 packing (.h5: datasets position [n][3], radius; optional density, velocity, omega, fixed)", CFG_CONDITIONAL},
     {"ibm", "density", CFG_DOUBLE, NULL, 1e-300, 1e300, NULL,
-     "density of the spheres of spheres_file that give none (required if one is free and has none)"},
+     "density of the spheres of spheres_file that give none (required if one is free and has none)", CFG_CONDITIONAL},
     {"ibm", "series_spheres", CFG_INT, "4", 0, 4, NULL,
      "the first this many spheres have their position, velocity, ω, force and torque as columns of series.csv"},
     SPHERE_KEY(1), SPHERE_KEY(2), SPHERE_KEY(3), SPHERE_KEY(4), SPHERE_KEY(5), SPHERE_KEY(6), SPHERE_KEY(7),

@@ -53,7 +53,7 @@ static const cfg_key_t porenet_keys[] = {
      "pore is solved for)"},
     {"porenet", "packing", CFG_STRING, NULL, 1, 0, NULL,
      "fixed packing when the scene has no DEM particles ([particles]): text (x y z r per line, # comments) "
-     "or HDF5 (.h5: datasets position [n][3] and radius, the layout of ibm.spheres_file)"},
+     "or HDF5 (.h5: datasets position [n][3] and radius, the layout of ibm.spheres_file)", CFG_CONDITIONAL},
     {"porenet", "gradient", CFG_VEC3, "0 0 0", -BIG, BIG, NULL,
      "mean pressure gradient imposed along the periodic axes (Pa/m)"},
     FACE_KEYS("x_lo"), FACE_KEYS("x_hi"), FACE_KEYS("y_lo"), FACE_KEYS("y_hi"), FACE_KEYS("z_lo"), FACE_KEYS("z_hi"),
