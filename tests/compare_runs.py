@@ -15,8 +15,9 @@ Prints the differences; exit status 0 when there are none.
     compare_runs.py A B --checkpoint-groups   (two checkpoint files: only the
                                                groups of the parts, without the
                                                list of the snapshots written)
-    compare_runs.py A B --skip NAME           (a dataset or attribute not
-                                               compared, e.g. input)
+    compare_runs.py A B --skip NAME           (a dataset, attribute, summary key
+                                               or file NAME.* not compared, e.g.
+                                               input)
 """
 import json
 import os
@@ -118,9 +119,10 @@ def flat(d, prefix=""):
             yield prefix + k, v
 
 
-def diff_summary(a, b):
-    da = {k: renamed(v) for k, v in flat(json.load(open(a))) if not any(m in k for m in MACHINE)}
-    db = {k: v for k, v in flat(json.load(open(b))) if not any(m in k for m in MACHINE)}
+def diff_summary(a, b, skip=()):
+    keep = lambda k: not any(m in k for m in MACHINE) and k.split(".")[-1] not in skip
+    da = {k: renamed(v) for k, v in flat(json.load(open(a))) if keep(k)}
+    db = {k: v for k, v in flat(json.load(open(b))) if keep(k)}
     return [f"{a}: {k}: {da.get(k)} and {db.get(k)}" for k in sorted(set(da) | set(db)) if da.get(k) != db.get(k)]
 
 
@@ -130,12 +132,14 @@ def diff_dirs(a, b, skip=()):
     out = [f"{f}: in one folder only ({a if f in fa else b})" for f in sorted(fa ^ fb)]
     for f in sorted(fa & fb):
         pa, pb = os.path.join(a, f), os.path.join(b, f)
+        if f.split(".")[0] in skip:
+            continue
         if f.endswith(".h5"):
             out += diff_h5(pa, pb, skip=skip)
         elif f.endswith(".csv"):
             out += diff_csv(pa, pb)
         elif f == "summary.json":
-            out += diff_summary(pa, pb)
+            out += diff_summary(pa, pb, skip)
         elif renamed(open(pa, "rb").read()) != open(pb, "rb").read():
             out.append(f"{pa}: differs")
     return out

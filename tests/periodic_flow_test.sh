@@ -5,7 +5,8 @@
 # reynolds_length without a periodic direction is bad input.  The held flow rate
 # ([fluid] flow_rate_direction): the superficial velocity is the target at every step, the body
 # force it reaches is the exact discrete one whatever the time step (explicit and Crank–Nicolson,
-# 1 and 2 ranks), a Reynolds-number target, restart = uninterrupted run, bad input.
+# 1 and 2 ranks), a Reynolds-number target, restart = uninterrupted run, bad input; the grid from
+# the resolution D/dx ([domain] cells_per_diameter).
 # Prints TAP lines.
 . "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_periodic_flow.XXXXXX)
@@ -131,4 +132,29 @@ bad "flow rate held with two targets" fluid.flow_rate_direction --set fluid.flow
 bad "a target without flow_rate_direction" fluid.superficial_velocity --set fluid.superficial_velocity=1
 bad "a Reynolds target without reynolds_length" fluid.reynolds --set fluid.flow_rate_direction=x --set fluid.reynolds=2 \
     --set fluid.reynolds_length=0
+
+# the grid from the resolution D/dx: cells_per_diameter = 16 with diameter 1 is the box of 32 x 16 x 8
+# cubic cells, the same run as the cell counts give (but for the input's text and fingerprint)
+G="--set time.t_end=0.004 --set fluid.dt=0.001"
+$BIN run $T/channel.ini $G --set domain.nx=32 --set domain.nz=8 --out $T/gn >$T/gn.log 2>&1 &&
+    mkdir -p $T/cpd && sed -e '/^nx =/d' -e '/^ny =/d' -e '/^nz =/d' $T/channel.ini >$T/cpd/channel.ini &&
+    $BIN run $T/cpd/channel.ini $G --set domain.cells_per_diameter=16 --set domain.diameter=1 --out $T/gd >$T/gd.log 2>&1 &&
+    grep -q "32 x 16 x 8 cells" $T/gd.log && $PY tests/compare_runs.py $T/gn $T/gd --skip input --skip fingerprint
+report $? "cells_per_diameter = 16, diameter = 1: 32 x 16 x 8 cells, the run of nx = 32, ny = 16, nz = 8"
+$BIN check $T/channel.ini --set domain.cells_per_diameter=16 --set domain.diameter=1 >$T/out 2>$T/err
+st=$?
+[ $st = 2 ] && grep -q "channel.ini:[0-9]*: domain.nx: give the cell counts or cells_per_diameter" $T/err
+report $? "cells_per_diameter with the cell counts: exit 2 ($st) with file:line: domain.nx"
+cpdbad() { # WHAT KEY SETS... (the case without cell counts)
+    local what=$1 key=$2
+    shift 2
+    $BIN check $T/cpd/channel.ini "$@" >$T/out 2>$T/err
+    local st=$?
+    [ $st = 2 ] && grep -q "^--set $key: " $T/err
+    report $? "$what: exit 2 ($st) with --set $key ($(head -1 $T/err | cut -c1-120))"
+}
+cpdbad "a resolution that is not a whole number of cells (0.5 / 0.3 x 16)" domain.cells_per_diameter \
+    --set domain.cells_per_diameter=16 --set domain.diameter=0.3
+cpdbad "a diameter without cells_per_diameter" domain.diameter --set domain.diameter=0.3 --set domain.nx=4 \
+    --set domain.ny=16 --set domain.nz=2
 tap_end $T

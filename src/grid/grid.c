@@ -10,9 +10,16 @@
 static const cfg_key_t grid_keys[] = {
     {"domain", "geometry", CFG_ENUM, "3d", 1, 0, "3d|2d|axisymmetric",
      "3d Cartesian, 2d planar (x, y), or axisymmetric (x = r from the axis, y = axial)"},
-    {"domain", "nx", CFG_INT, NULL, 1, 1 << 20, NULL, "cells in x (r when axisymmetric); must divide by the rank count"},
-    {"domain", "ny", CFG_INT, NULL, 1, 1 << 20, NULL, "cells in y"},
+    {"domain", "nx", CFG_INT, NULL, 1, 1 << 20, NULL,
+     "cells in x (r when axisymmetric); must divide by the rank count; or give cells_per_diameter",
+     CFG_CONDITIONAL},
+    {"domain", "ny", CFG_INT, NULL, 1, 1 << 20, NULL, "cells in y; or give cells_per_diameter", CFG_CONDITIONAL},
     {"domain", "nz", CFG_INT, "1", 1, 1 << 20, NULL, "cells in z (must be 1 in 2d and axisymmetric)"},
+    {"domain", "cells_per_diameter", CFG_DOUBLE, NULL, 1e-300, 1e300, NULL,
+     "the resolution D/Δx instead of nx, ny, nz: each direction gets length/diameter × cells_per_diameter cells "
+     "(a whole number: bad input otherwise), the cells are cubes; uniform grids only", CFG_OPTIONAL},
+    {"domain", "diameter", CFG_DOUBLE, NULL, 1e-300, 1e300, NULL,
+     "the diameter D (m) of cells_per_diameter (e.g. the sphere's)", CFG_CONDITIONAL},
     {"domain", "length", CFG_VEC3, NULL, 1e-300, 1e300, NULL, "domain size Lx Ly Lz (Lz ignored in 2-D)"},
     {"domain", "origin", CFG_VEC3, "0 0 0", -1e300, 1e300, NULL, "low corner of the domain (x must be 0 when axisymmetric)"},
     {"domain", "x_stretch", CFG_ENUM, "uniform", 1, 0, "uniform|tanh_low|tanh_high|tanh_both|uniform_arithmetic",
@@ -35,14 +42,49 @@ void grid_register_keys(void) { cfg_schema_add(grid_keys); }
 
 static const char *face_name[3][2] = {{"x_lo", "x_hi"}, {"y_lo", "y_hi"}, {"z_lo", "z_hi"}};
 
+/* [domain] cells_per_diameter = D/Δx with diameter = D: n_d = L_d D⁻¹ (D/Δx) cells
+ * in each direction, which must be a whole number (to 1e-9 of it), so that the
+ * cells are cubes of side D/(D/Δx). */
+static void cells_from_diameter(cfg_t *cfg, geom_t geom, stretch_t st, const double L[3], int n[3])
+{
+    static const char *nkey[3] = {"nx", "ny", "nz"};
+    for (int d = 0; d < 3; d++)
+        if (cfg_has(cfg, "domain", nkey[d]))
+            cfg_fail(cfg, "domain", nkey[d], "give the cell counts or cells_per_diameter, not both");
+    if (st != STRETCH_UNIFORM)
+        cfg_fail(cfg, "domain", "cells_per_diameter", "needs a uniform grid (x_stretch = uniform)");
+    const double cpd = cfg_double(cfg, "domain", "cells_per_diameter"), D = cfg_double(cfg, "domain", "diameter");
+    const int dims = geom == GEOM_3D ? 3 : 2;
+    n[2] = 1;
+    for (int d = 0; d < dims; d++) {
+        const double c = L[d] / D * cpd;
+        if (!(c >= 0.5 && c < (1 << 20)) || fabs(c - nearbyint(c)) > 1e-9 * c)
+            cfg_fail(cfg, "domain", "cells_per_diameter",
+                     "length %c / diameter × cells_per_diameter = %.10g / %.10g × %.10g = %.10g is not a whole number of "
+                     "cells: change the length or the resolution",
+                     "xyz"[d], L[d], D, cpd, c);
+        n[d] = (int)nearbyint(c);
+    }
+    msg("domain: D/dx = %g with D = %g: %d x %d x %d cells\n", cpd, D, n[0], n[1], n[2]);
+}
+
 grid_t *grid_create_from_config(cfg_t *cfg, MPI_Comm comm)
 {
     geom_t geom = (geom_t)cfg_enum(cfg, "domain", "geometry");
-    int n[3] = {cfg_int(cfg, "domain", "nx"), cfg_int(cfg, "domain", "ny"), cfg_int(cfg, "domain", "nz")};
     double L[3], x0[3];
     cfg_vec3(cfg, "domain", "length", L);
     cfg_vec3(cfg, "domain", "origin", x0);
     stretch_t st = (stretch_t)cfg_enum(cfg, "domain", "x_stretch");
+    int n[3];
+    if (cfg_has(cfg, "domain", "cells_per_diameter"))
+        cells_from_diameter(cfg, geom, st, L, n);
+    else {
+        if (cfg_has(cfg, "domain", "diameter"))
+            cfg_fail(cfg, "domain", "diameter", "the diameter of cells_per_diameter, which is not given");
+        n[0] = cfg_int(cfg, "domain", "nx");
+        n[1] = cfg_int(cfg, "domain", "ny");
+        n[2] = cfg_int(cfg, "domain", "nz");
+    }
     double beta = cfg_double(cfg, "domain", "x_stretch_beta");
     bc_t bc;
     memset(&bc, 0, sizeof bc);
