@@ -31,9 +31,10 @@ static const cfg_key_t ibm_keys[] = {
     {"ibm", "gravity", CFG_VEC3, "0 0 0", -1e300, 1e300, NULL,
      "gravity acting on the free spheres (their immersed weight (ρp-ρ)V g; the fluid pressure is relative to "
      "hydrostatic)"},
-    {"ibm", "forcing_time", CFG_DOUBLE, "0", 0, 1e6, NULL,
+    {"ibm", "forcing_time", CFG_DOUBLE, "0.2", 0, 1e6, NULL,
      "κ: a node of solid fraction α < 1 is forced by u ← u + β(U − u), β = αΔt_k/((1−α)κh²/ν + αΔt_k), whose "
-     "steady state does not depend on the time step; 0: the seed's β = α at every stage (depends on Δt)"},
+     "steady state does not depend on the time step; 0: the seed's β = α at every stage (depends on Δt; for "
+     "comparisons with the thesis)"},
     {"ibm", "free_alpha", CFG_ENUM, "stage", 1, 0, "stage|step",
      "where a free sphere's solid fraction is over a fluid step: moved to the predicted centre after every "
      "Runge-Kutta stage (stage), or held where the step started and moved between steps, the fluid momentum "
