@@ -86,6 +86,7 @@ typedef struct {
     long max_steps;        /* stop after this step number (0: no limit) */
     double wall_limit;     /* stop (with a checkpoint) after this many seconds (0: none) */
     double steady_tol;     /* stop when every part's relative rate of change < this (0: off) */
+    int steady_integrals;  /* 1: the rates are those of integrals (flux, forces), not of fields */
     double cfl_abort;      /* hard CFL limit: above it the run has diverged */
     double ke_growth_abort; /* kinetic energy growing by more than this factor in one step: diverged */
     int rollback;          /* keep the previous state (checkpoint on divergence, steady test) */

@@ -100,6 +100,50 @@ sys.exit(0 if ok else 1)
 PY
 report $? "held flow rate: superficial_u = 0.25 after every step; body_force_x = the exact discrete f to 1e-10 for dt = 0.002 (explicit) and 0.05 (Crank-Nicolson)"
 
+# the steady path: the held flow rate with Crank-Nicolson steps of 0.05 and the integral steady test
+# (time.steady_measure = integrals: the body force's relative change below 1e-6 per unit time) stops
+# the run as steady long before t_end, the body force within 1e-5 of the exact f (what is left of the
+# slowest mode, decaying over h^2/(pi^2 nu) = 0.2, is about 0.2 x 1e-6)
+$BIN run $T/channel.ini $HOLD --set time.t_end=100 --set fluid.dt=0.05 --set fluid.viscous=implicit \
+    --set time.steady_tol=1e-6 --set time.steady_measure=integrals --out $T/st >$T/st.log 2>&1 &&
+    $PY - $T/st <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1] + "/summary.json"))
+nu, h, dy, U = 0.5, 1.0, 1.0 / 16, 0.25
+fx = U / (h * h / (12 * nu) + dy * dy / (24 * nu))
+print("status %s at t = %g (%d steps), f/f_exact - 1 = %.2e" % (s["status"], s["time"], s["steps"],
+                                                             s["fluid"]["body_force_x"] / fx - 1))
+sys.exit(not (s["status"] == "steady" and s["time"] < 50 and abs(s["fluid"]["body_force_x"] / fx - 1) < 1e-5))
+PY
+report $? "steady path (held flow rate, Crank-Nicolson dt = 0.05, steady_measure = integrals): steady before t = 50, f within 1e-5"
+
+# the steady path past a fixed sphere: the simple cubic array c = 0.064 at D/dx = 7.9 (16^3, body
+# force 1: Re 0.3), run explicitly until the velocity field is steady (the usual path: ~950 steps),
+# then at the superficial velocity it reached with the held flow rate, Crank-Nicolson steps of 0.05
+# (cn_forcing = predictor) and the integral test: the same drag to 1e-3 (measured 1.7e-4: the two
+# tolerances) in fewer than a tenth of the steps (measured 11)
+L=2.014989942520587
+ARR="--set domain.nx=16 --set domain.ny=16 --set domain.nz=16 --set domain.length=$L,$L,$L
+     --set boundary.y_lo=periodic --set boundary.y_hi=periodic --set fluid.init=rest --set fluid.nu=1
+     --set fluid.wall_ghost=linear --set fluid.reynolds_length=1 --set fluid.dt=0
+     --set ibm.sphere1=fixed,center,1.0074949712602934,1.0074949712602934,1.0074949712602934,diameter,1
+     --set ibm.radius_correction=calibrated --set time.t_end=8 --set time.steady_tol=1e-3"
+$BIN run $T/channel.ini $ARR --set fluid.body_force=1,0,0 --set fluid.viscous=explicit --set fluid.fourier=0.6 \
+    --out $T/ae >$T/ae.log 2>&1 &&
+    Ua=$($PY -c "import json; print(repr(json.load(open('$T/ae/summary.json'))['fluid']['superficial_velocity_x']))") &&
+    $BIN run $T/channel.ini $ARR --set fluid.body_force=1,0,0 --set fluid.viscous=implicit --set ibm.cn_forcing=predictor \
+        --set fluid.dt=0.05 --set time.steady_measure=integrals --set fluid.flow_rate_direction=x \
+        --set fluid.superficial_velocity=$Ua --out $T/ah >$T/ah.log 2>&1 &&
+    $PY - $T/ae $T/ah <<'PY'
+import json, math, sys
+a, b = (json.load(open(d + "/summary.json")) for d in sys.argv[1:])
+K = [s["ibm"]["sphere1"]["force_x"] / (3 * math.pi * s["fluid"]["superficial_velocity_x"]) for s in (a, b)]
+print("K explicit %.5f (%d steps), held + Crank-Nicolson %.5f (%d steps): %+.2e" % (K[0], a["steps"], K[1], b["steps"],
+                                                                                 K[1] / K[0] - 1))
+sys.exit(not (a["status"] == b["status"] == "steady" and abs(K[1] / K[0] - 1) < 1e-3 and 10 * b["steps"] < a["steps"]))
+PY
+report $? "steady path past a sphere array: the explicit drag to 1e-3 in a tenth of the steps"
+
 # a Reynolds-number target (Re = U l/nu with reynolds_length l = 0.25: Re 2 is U = 4)
 $BIN run $T/channel.ini --set fluid.init=rest --set fluid.flow_rate_direction=x --set fluid.reynolds=2 \
     --set time.t_end=0.02 --out $T/re >$T/re.log 2>&1 &&

@@ -18,6 +18,7 @@ typedef struct {
     fluid_t *f;
     double *prev[4];      /* u, v, w, p at the start of the step (rollback) */
     double prev_time, prev_body_force[3];
+    double prev_flow[3];  /* superficial velocities at the start of the step (steady_measure = integrals) */
     long prev_step;
     fluid_diag_t prev_diag; /* the diagnostics of the step before */
     int prev_stepped;
@@ -168,6 +169,8 @@ static void part_keep_previous(void *ctx)
     }
     fp->prev_time = f->time;
     memcpy(fp->prev_body_force, f->prm.body_force, sizeof fp->prev_body_force);
+    if (fp->sim->prm.steady_integrals && fp->sim->prm.steady_tol > 0)
+        for (int m = 0; m < fp->nper; m++) fp->prev_flow[m] = fluid_mean_velocity(f, fp->per[m]);
     fp->prev_step = f->step;
     fp->prev_diag = f->diag;
     fp->prev_stepped = fp->stepped;
@@ -193,10 +196,30 @@ static void part_restore_previous(void *ctx)
 
 /* max |u(n+1) − u(n)| / (Δt max |u(n+1)|) over the interior: the relative
  * rate of change per unit time, which tends to 0 at a steady state. */
+/* steady_measure = integrals: the relative rate of change of the superficial
+ * velocities and of a held flow rate's body force */
+static double flow_change_rate(const fluid_part_t *fp, double dt)
+{
+    const fluid_t *f = fp->f;
+    double dU = 0, Um = 0;
+    for (int m = 0; m < fp->nper; m++) {
+        const double U = fluid_mean_velocity(f, fp->per[m]);
+        dU = fmax(dU, fabs(U - fp->prev_flow[m]));
+        Um = fmax(Um, fabs(U));
+    }
+    double rate = Um > 0 ? dU / (dt * Um) : 0.0;
+    if (f->prm.hold_flow) {
+        const double b = f->prm.body_force[f->prm.hold_dir], b0 = fp->prev_body_force[f->prm.hold_dir];
+        rate = fmax(rate, b != 0 ? fabs(b - b0) / (dt * fabs(b)) : 0.0);
+    }
+    return rate;
+}
+
 static double part_change_rate(void *ctx, double dt)
 {
     fluid_part_t *fp = ctx;
     const grid_t *g = fp->g;
+    if (fp->sim->prm.steady_integrals && fp->nper) return flow_change_rate(fp, dt);
     double du = 0, umax = 0;
     for (int c = 0; c < ncomp(fp); c++) {
         const double *u = fp->f->u[c], *u0 = fp->prev[c];

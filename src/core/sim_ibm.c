@@ -172,18 +172,23 @@ static void part_restore_previous(void *ctx)
     ibm_rebuild_geometry(ip->ibm); /* the fluid part restored its fields first */
 }
 
-/* max |u(n+1) − u(n)| / (Δt max|u(n+1)|) over the spheres' velocities */
+/* max |u(n+1) − u(n)| / (Δt max|u(n+1)|) over the spheres' velocities, and
+ * with steady_measure = integrals the same of the forces on the spheres */
 static double part_change_rate(void *ctx, double dt)
 {
     ibm_part_t *ip = ctx;
     if (!ip->prev) return INFINITY;
-    double du = 0, um = 0;
+    double du = 0, um = 0, df = 0, fm = 0;
     for (int p = 0; p < ip->ibm->n; p++)
         for (int c = 0; c < 3; c++) {
             du = fmax(du, fabs(ip->ibm->s[p].u[c] - ip->prev[p].u[c]));
             um = fmax(um, fabs(ip->ibm->s[p].u[c]));
+            df = fmax(df, fabs(ip->ibm->s[p].force[c] - ip->prev[p].force[c]));
+            fm = fmax(fm, fabs(ip->ibm->s[p].force[c]));
         }
-    return um > 0 ? du / (dt * um) : 0.0;
+    const double rate = um > 0 ? du / (dt * um) : 0.0;
+    if (!ip->sim->prm.steady_integrals) return rate;
+    return fmax(rate, fm > 0 ? df / (dt * fm) : 0.0);
 }
 
 /* The solid fraction at the cell centres, in every fluid snapshot. */
