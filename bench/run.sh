@@ -5,7 +5,7 @@
 # the load average, since a busy machine skews wall times).
 #
 #   ONLY=regex   run only the sections whose name matches (fluid, poisson,
-#                multigrid, porenet, dry, dem, ibm)
+#                multigrid, porenet, dry, dem, ibm, steady)
 #   N=64         grid size of the fluid/Poisson benches (default 128)
 #   FFTW_WISDOM  wisdom file of the measuring planner (default $BUILD/bench_results/fftw.wisdom)
 #   Builds nothing (`make bench` builds first).
@@ -61,6 +61,10 @@ if want dry; then
 fi
 if want ibm && [ -x "$BUILD/bench/bench_ibm" ]; then
     for np in 1 2; do run ibm_np$np $MPIRUN -np $np "$BUILD/bench/bench_ibm"; done
+fi
+if want steady; then
+    # a steady flow past a sphere array: explicit path against the held flow rate with Crank-Nicolson steps
+    run steady bash bench/steady_path.sh
 fi
 if want dem; then
     # ibmdem against LIGGGHTS on ../shared/bench/dem (installs liggghts; long)
