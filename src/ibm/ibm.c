@@ -40,11 +40,12 @@ static const cfg_key_t ibm_keys[] = {
      "Runge-Kutta stage (stage), or held where the step started and moved between steps, the fluid momentum "
      "over the jump counted in the next force (step: one rebuild per step instead of three, see "
      "docs/theory.md)"},
-    {"ibm", "cn_forcing", CFG_ENUM, "after_solve", 1, 0, "after_solve|predictor",
-     "with the Crank-Nicolson viscous term ([fluid] viscous = implicit, or auto on its implicit steps): the forcing is computed from the Crank-Nicolson solution and applied "
-     "after the solve (after_solve), or from the explicit predictor with the whole viscous term and applied as a "
-     "source term of the implicit solve (predictor: stable and accurate at large Δt ν/Δx², see docs/theory.md "
-     "§4.6); no effect with the explicit viscous term"},
+    {"ibm", "cn_forcing", CFG_ENUM, "predictor", 1, 0, "after_solve|predictor",
+     "with the Crank-Nicolson viscous term ([fluid] viscous = implicit, or auto on its implicit steps): the forcing "
+     "is computed from the explicit predictor with the whole viscous term and applied as a source term of the "
+     "implicit solve (predictor: stable at large Δt ν/Δx², steady states independent of Δt, see docs/theory.md "
+     "§4.6), or computed from the Crank-Nicolson solution and applied after the solve (after_solve: the seed's "
+     "order, porous to the implicit viscous term at large Δt ν/Δx²); no effect with the explicit viscous term"},
     {"ibm", "retraction", CFG_DOUBLE, "0", -1, 1, NULL,
      "the solid fraction is that of a sphere of radius R - retraction × Δx (cells): compensates the effective "
      "thickening of the forced sphere (0: the seed's method)"},
