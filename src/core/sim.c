@@ -1,6 +1,7 @@
 /* sim.c — the run driver (see sim.h): the time loop, the stop conditions,
  * the divergence checks and the schedule of the outputs.  The physics lives
- * in the parts (sim_fluid.c, ...). */
+ * in the parts (sim_fluid.c, ...); the driver's keys are read in
+ * sim_params.c, its checkpoints written and read in sim_checkpoint.c. */
 #include "coupling.h"
 #include "poisson.h"
 #include "sim.h"
@@ -12,108 +13,8 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "sim_internal.h"
 #include "util.h"
-
-static const cfg_key_t sim_keys[] = {
-    {"time", "t_end", CFG_DOUBLE, NULL, 0, 1e300, NULL, "simulated time at which the run stops"},
-    {"time", "max_steps", CFG_INT, "0", 0, 2147483647, NULL,
-     "stop after this step number (counted from the start of the run, restarts included); 0: no limit"},
-    {"time", "wall_limit", CFG_DOUBLE, "0", 0, 1e300, NULL,
-     "stop with a checkpoint after this many seconds of wall time; 0: no limit"},
-    {"time", "steady_tol", CFG_DOUBLE, "0", 0, 1e300, NULL,
-     "stop when the relative rate of change per unit time (steady_measure) falls below this; 0: off"},
-    {"time", "steady_measure", CFG_ENUM, "field", 1, 0, "field|integrals",
-     "steady_tol measures field: max|u(n+1) - u(n)| / (dt max|u|) over the velocity field (and the particles' "
-     "velocities); integrals: the quantities a steady flow is run for — the superficial velocity along each "
-     "periodic direction (and a held flow rate's body force) and the force on each immersed sphere, "
-     "max|q(n+1) - q(n)| / (dt max|q|) (the field where the domain has no periodic direction)"},
-    {"time", "cfl_abort", CFG_DOUBLE, "1.5", 1e-3, 100, NULL,
-     "hard CFL limit: a step above it (or above twice the CFL target of an adaptive step) means divergence"},
-    {"time", "ke_growth_abort", CFG_DOUBLE, "100", 1.000001, 1e300, NULL,
-     "kinetic energy growing by more than this factor in one step means divergence"},
-    {"time", "step_retries", CFG_INT, "4", 0, 100, NULL,
-     "a step of an adaptive fluid step that diverges (CFL or kinetic-energy limit, non-finite values) is taken "
-     "again from its start with half its time step, up to this many times, before the run stops as diverged "
-     "(needs rollback; each retry is logged, their count is summary.json's rejected_steps); 0: stop at the first "
-     "divergence"},
-    {"time", "rollback", CFG_BOOL, "true", 1, 0, NULL,
-     "keep the state at the start of each step, so a diverging run checkpoints its last good state "
-     "(costs one copy of the velocity and pressure, of the spheres, of the DEM's particles, springs and lists, "
-     "and of the pore network's state)"},
-    {"output", "dir", CFG_STRING, "out/NAME", 1, 0, NULL, "output folder (created); --out DIR sets it too"},
-    {"output", "name", CFG_STRING, "case file name", 1, 0, NULL, "case name written in summary.json"},
-    {"output", "fields_every", CFG_DOUBLE, "0", 0, 1e300, NULL,
-     "simulated time between field snapshots (fields_NNNNN.h5 + fields.xmf); 0: initial and final only"},
-    {"output", "series_every", CFG_INT, "1", 1, 2147483647, NULL, "steps between rows of series.csv"},
-    {"output", "checkpoint_every", CFG_INT, "0", 0, 2147483647, NULL,
-     "steps between checkpoints (checkpoint_SSSSSSSS.h5); 0: at the end only"},
-    {"output", "checkpoint_keep", CFG_INT, "2", 0, 1000000, NULL, "newest checkpoints kept in the folder; 0: all"},
-    {"output", "overwrite", CFG_BOOL, "false", 1, 0, NULL,
-     "a new run into a folder that holds the outputs of an earlier run: false: refused; true: those files are "
-     "deleted first (a restart continues in place whatever this is)"},
-    {"output", "progress", CFG_ENUM, "auto", 1, 0, "auto|on|off",
-     "progress line redrawn in place: auto = when stdout is a terminal and the run was not started by mpirun "
-     "(whose processes always see a pseudo-terminal), on, off"},
-    {NULL, NULL, 0, NULL, 0, 0, NULL, NULL}};
-
-void sim_register_keys(void) { cfg_schema_add(sim_keys); }
-
-const char *const sim_run_control_keys[] = {"time.t_end",     "time.max_steps", "time.wall_limit", "time.steady_tol",
-                                            "time.cfl_abort", "time.ke_growth_abort", "time.rollback",
-                                            "time.step_retries", "time.steady_measure",
-                                            "output.*",       "poisson.fftw_wisdom", NULL};
-
-static void read_params(sim_t *s, cfg_t *cfg)
-{
-    sim_params_t *p = &s->prm;
-    p->t_end = cfg_double(cfg, "time", "t_end");
-    p->max_steps = cfg_int(cfg, "time", "max_steps");
-    p->wall_limit = cfg_double(cfg, "time", "wall_limit");
-    p->steady_tol = cfg_double(cfg, "time", "steady_tol");
-    p->steady_integrals = cfg_enum(cfg, "time", "steady_measure") == 1;
-    p->cfl_abort = cfg_double(cfg, "time", "cfl_abort");
-    p->ke_growth_abort = cfg_double(cfg, "time", "ke_growth_abort");
-    p->rollback = cfg_bool(cfg, "time", "rollback");
-    p->step_retries = cfg_int(cfg, "time", "step_retries");
-    /* The case name defaults to the file name without its directory and .ini */
-    if (cfg_has(cfg, "output", "name")) {
-        if (strlen(cfg_string(cfg, "output", "name")) >= sizeof p->name)
-            cfg_fail(cfg, "output", "name", "longer than %zu bytes", sizeof p->name - 1);
-        snprintf(p->name, sizeof p->name, "%s", cfg_string(cfg, "output", "name"));
-    } else {
-        const char *base = strrchr(cfg_path(cfg), '/');
-        snprintf(p->name, sizeof p->name, "%s", base ? base + 1 : cfg_path(cfg));
-        char *dot = strrchr(p->name, '.');
-        if (dot && dot != p->name) *dot = 0;
-    }
-    if (cfg_has(cfg, "output", "dir")) {
-        if (strlen(cfg_string(cfg, "output", "dir")) >= sizeof p->dir)
-            cfg_fail(cfg, "output", "dir", "the path is longer than %zu bytes", sizeof p->dir - 1);
-        snprintf(p->dir, sizeof p->dir, "%s", cfg_string(cfg, "output", "dir"));
-    } else {
-        snprintf(p->dir, sizeof p->dir, "out/%s", p->name);
-    }
-    /* every file name inside the folder must fit in a path the system takes */
-    const size_t longest = strlen("/checkpoint_00000000000.h5.tmp") + 16;
-    if (strlen(p->dir) + longest >= PATH_MAX || strlen(p->dir) + longest >= IO_PATH_MAX)
-        cfg_fail(cfg, "output", "dir", "a path of %zu characters: at most %zu (the system's PATH_MAX %d less the "
-                 "longest file name inside it)", strlen(p->dir), (size_t)PATH_MAX - longest - 1, PATH_MAX);
-    for (const char *c = p->dir; *c;) {
-        size_t len = strcspn(c, "/");
-        if (len > NAME_MAX)
-            cfg_fail(cfg, "output", "dir", "a folder name of %zu characters: at most %d (the system's NAME_MAX)", len,
-                     NAME_MAX);
-        c += len + (c[len] == '/');
-    }
-    p->overwrite = cfg_bool(cfg, "output", "overwrite");
-    p->fields_every = cfg_double(cfg, "output", "fields_every");
-    p->series_every = cfg_int(cfg, "output", "series_every");
-    p->checkpoint_every = cfg_int(cfg, "output", "checkpoint_every");
-    p->checkpoint_keep = cfg_int(cfg, "output", "checkpoint_keep");
-    p->progress = cfg_enum(cfg, "output", "progress");
-    if (p->steady_tol > 0 && !p->rollback)
-        cfg_fail(cfg, "time", "steady_tol", "needs time.rollback = true (the previous state is compared)");
-}
 
 void sim_add_part(sim_t *s, const sim_part_t *part)
 {
@@ -134,138 +35,6 @@ void sim_add_field_writer(sim_t *s, sim_field_writer_t fn, void *ctx)
     s->field_writer_ctx[s->nfield_writers++] = ctx;
 }
 
-/* ---- checkpoints --------------------------------------------------------- */
-
-/* The step of the last series row at or before `step` (the row a checkpoint
- * of that step follows: a diverged run checkpoints the step before its last
- * row). */
-static long series_row_before(const sim_t *s, long step)
-{
-    return s->last_series_step <= step ? s->last_series_step : s->prev_series_step;
-}
-
-/* What to say if the run must stop at once (a failed collective write). */
-static void note_checkpoint(const sim_t *s, const char *path)
-{
-    char text[IO_PATH_MAX + 64];
-    snprintf(text, sizeof text, "the newest checkpoint is %s", path);
-    io_recovery_note(text);
-}
-
-/* Write a checkpoint of the current state.  The time series and the log are
- * made durable (fsync) first, and the checkpoint is renamed to its final name
- * only when complete: whenever a checkpoint exists, the outputs it refers to
- * do too.  Returns 0, or -1 on every rank after an I/O error (the previous
- * checkpoint is then still the newest). */
-static int write_checkpoint(sim_t *s)
-{
-    if (mpi_rank() == 0) {
-        io_series_sync_all();
-        msg_sync_log();
-    }
-    io_checkpoint_header_t h = {s->time, s->step, s->fingerprint, mpi_size(), s->input};
-    hid_t f = io_checkpoint_begin(s->out.dir, &h, s->comm);
-    io_h5_attr_double(f, "next_fields_time", s->next_fields);
-    io_h5_attr_long(f, "series_last_step", series_row_before(s, s->step));
-    io_h5_attr_hash(f, "series_hash", io_series_hash(s->series, s->step), s->comm);
-    io_h5_attr_long(f, "fields_last_step", s->last_fields_step);
-    io_h5_attr_double(f, "last_dt", s->dt);
-    io_h5_attr_long(f, "rejected_steps", s->rejected_steps);
-    for (int i = 0; i < s->npart; i++) {
-        sim_part_t *p = &s->part[i];
-        if (!p->checkpoint_write) continue;
-        hid_t g = H5Gcreate2(f, p->name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-        p->checkpoint_write(p->ctx, g);
-        H5Gclose(g);
-    }
-    if (io_checkpoint_end(f, s->out.dir, s->step, s->prm.checkpoint_keep, s->last_checkpoint,
-                          sizeof s->last_checkpoint, s->comm))
-        return -1;
-    s->last_checkpoint_step = s->step;
-    note_checkpoint(s, s->last_checkpoint);
-    return 0;
-}
-
-/* Rank 0 decides: do two paths name the same file? */
-static int same_file(const char *a, const char *b)
-{
-    struct stat sa, sb;
-    int same = stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
-    MPI_Bcast(&same, 1, MPI_INT, 0, MPI_COMM_WORLD);
-    return same;
-}
-
-static void report_diff(const char *key, const char *va, const char *vb, void *ctx)
-{
-    (void)ctx;
-    warn("  %s: %s in the checkpoint, %s now\n", key, va ? va : "(not set)", vb ? vb : "(not set)");
-}
-
-static void read_checkpoint(sim_t *s, const char *path)
-{
-    io_checkpoint_header_t h;
-    hid_t f = io_checkpoint_open(path, &h, s->comm);
-    if (h.nranks != mpi_size())
-        warn("%s was written by %d ranks, this run has %d: the continuation agrees to round-off, not bit for bit\n",
-             path, h.nranks, mpi_size());
-    if (h.fingerprint != s->fingerprint) {
-        warn("%s was written with a different input (fingerprint %016" PRIx64 ", now %016" PRIx64
-             "); the keys that differ:\n",
-             path, h.fingerprint, s->fingerprint);
-        io_input_diff(h.input, s->input, sim_run_control_keys, report_diff, NULL);
-    }
-    s->time = h.time;
-    s->step = h.step;
-    if (io_h5_get_attr_double(f, "next_fields_time", &s->next_fields)) s->next_fields = s->time;
-    s->series_resume.step = s->step;
-    if (io_h5_get_attr_long(f, "series_last_step", &s->series_resume.last_row)) s->series_resume.last_row = -1;
-    s->series_resume.has_hash = io_h5_get_attr_hash(f, "series_hash", &s->series_resume.hash) == 0;
-    if (io_h5_get_attr_long(f, "fields_last_step", &s->last_fields_step)) s->last_fields_step = -1;
-    if (io_h5_get_attr_double(f, "last_dt", &s->dt)) s->dt = 0;
-    if (io_h5_get_attr_long(f, "rejected_steps", &s->rejected_steps)) s->rejected_steps = 0;
-    /* the folder's own checkpoint of this step: not written again at the end */
-    char own[IO_PATH_MAX + 64];
-    snprintf(own, sizeof own, "%s/checkpoint_%08ld.h5", s->out.dir, s->step);
-    if (same_file(own, path)) {
-        snprintf(s->last_checkpoint, sizeof s->last_checkpoint, "%s", own);
-        s->last_checkpoint_step = s->step;
-    }
-    /* what the lost continuation of this checkpoint wrote in the folder: its
-     * checkpoints (else they would be kept as the newest and ours pruned; the
-     * unfinished ones went when the folder was opened); the parts delete
-     * their own snapshots after theirs */
-    io_outdir_remove_numbered(&s->out, "checkpoint_", ".h5", s->step + 1);
-    io_checkpoint_prune(s->out.dir, s->prm.checkpoint_keep); /* a run killed before it pruned */
-    for (int i = 0; i < s->npart; i++) {
-        sim_part_t *p = &s->part[i];
-        if (!p->checkpoint_read) continue;
-        if (H5Lexists(f, p->name, H5P_DEFAULT) <= 0)
-            die("%s: no /%s group: the checkpoint was written by a scene without this part", path, p->name);
-        hid_t g = H5Gopen2(f, p->name, H5P_DEFAULT);
-        p->checkpoint_read(p->ctx, g, path);
-        H5Gclose(g);
-    }
-    io_checkpoint_header_free(&h);
-    io_h5_close(f);
-    note_checkpoint(s, path);
-    msg("restarted from %s at step %ld, t = %.10g\n", path, s->step, s->time);
-}
-
-/* The FFTW wisdom the measuring planner made its plans from, as
- * DIR/fftw.wisdom: `--set poisson.fftw_wisdom=DIR/fftw.wisdom` makes the
- * same plans in another run (bit-identical results). */
-static void write_fftw_wisdom(const sim_t *s)
-{
-    const char *w = poisson_fftw_wisdom_used();
-    if (!w || mpi_rank() != 0) return;
-    char path[IO_PATH_MAX + 16], tmp[IO_PATH_MAX + 32];
-    io_outdir_path(&s->out, "fftw.wisdom", path, sizeof path);
-    FILE *f = atomic_open(path, tmp, sizeof tmp);
-    if (!f) return;
-    fputs(w, f);
-    atomic_commit(f, tmp, path);
-}
-
 /* ---- setup ----------------------------------------------------------------- */
 
 sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
@@ -274,7 +43,7 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
     s->cfg = cfg;
     s->comm = MPI_COMM_WORLD;
     s->check_only = check_only;
-    read_params(s, cfg);
+    sim_read_params(s, cfg);
     /* known to the parts as they are built (the fluid's planner imports the
      * checkpoint's FFTW wisdom before it plans) */
     if (restart) snprintf(s->restart_path, sizeof s->restart_path, "%s", restart);
@@ -298,8 +67,8 @@ sim_t *sim_create(cfg_t *cfg, const char *restart, int check_only)
     io_outdir_write_input(&s->out, cfg);
     msg("ibmdem %s: case %s (%s) on %d rank%s, output in %s\n", IBMDEM_VERSION, s->prm.name, cfg_path(cfg),
         mpi_size(), mpi_size() > 1 ? "s" : "", s->prm.dir);
-    write_fftw_wisdom(s);
-    if (restart) read_checkpoint(s, restart);
+    sim_write_fftw_wisdom(s);
+    if (restart) sim_read_checkpoint(s, restart);
     s->step0 = s->step;
 
     /* Time series: step, time, dt, the parts' columns, wall time per step. */
@@ -475,7 +244,7 @@ static int outputs_due(sim_t *s)
     if (s->time >= s->next_fields * (1.0 - 1e-12)) write_fields(s);
     if (s->prm.checkpoint_every > 0 && s->step % s->prm.checkpoint_every == 0) {
         io_progress_clear(&s->progress);
-        if (write_checkpoint(s)) return -1;
+        if (sim_write_checkpoint(s)) return -1;
     }
     /* a line in the log every 10 % of the run (the terminal has the progress line) */
     double frac = progress_fraction(s);
@@ -558,7 +327,7 @@ static int stop_io_error(sim_t *s)
     if (!saved) {
         /* the error is known: see whether a checkpoint can still be written (another file system, room freed) */
         io_error_clear();
-        saved = write_checkpoint(s) == 0;
+        saved = sim_write_checkpoint(s) == 0;
     }
     io_error_clear();
     write_summary(s);
@@ -626,7 +395,7 @@ static int stop_diverged(sim_t *s)
         s->step = s->step_prev;
         s->dt = s->dt_prev;
     }
-    if (write_checkpoint(s) != 0) {
+    if (sim_write_checkpoint(s) != 0) {
         io_check_errors(s->comm, s->io_why, sizeof s->io_why);
         char text[2 * IO_PATH_MAX];
         snprintf(text, sizeof text, "the run diverged at step %ld (t = %.10g): %s\n", bad_step, bad_time, s->why);
@@ -669,7 +438,7 @@ static int stop_no_step(sim_t *s, double dt)
     if (s->last_series_step != s->step) write_series_row(s);
     char text[2 * IO_PATH_MAX];
     snprintf(text, sizeof text, "the run cannot go on at step %ld: %s\n", s->step, s->why);
-    if (s->last_checkpoint_step != s->step && write_checkpoint(s) != 0) {
+    if (s->last_checkpoint_step != s->step && sim_write_checkpoint(s) != 0) {
         io_check_errors(s->comm, s->io_why, sizeof s->io_why);
         report_error(s, text);
         return stop_io_error(s);
@@ -724,7 +493,7 @@ int sim_run(sim_t *s)
     /* a scene whose parts have no state (a fixed packing solved once) has nothing to restart from */
     int state = 0;
     for (int i = 0; i < s->npart; i++) state |= s->part[i].checkpoint_write != NULL;
-    if (s->last_checkpoint_step != s->step && state && write_checkpoint(s) != 0) {
+    if (s->last_checkpoint_step != s->step && state && sim_write_checkpoint(s) != 0) {
         io_check_errors(s->comm, s->io_why, sizeof s->io_why);
         return stop_io_error(s);
     }
