@@ -34,7 +34,9 @@ The deposit (the last particle snapshot):
           centres (z = 0), as H0
   R_inf   the final front x_front (as above, not relative to R0): R_inf/R0 = 1 + front_final
   H_inf   the final height at the wall: the larger h of the first two bins (x in [0, 2D]: the
-          grains against the wall sit lower than the next ones); H_inf/R0 and H_inf/H0
+          grains against the wall sit lower than the next ones); H_inf/R0 and H_inf/H0; H_wall0
+          the same on the first snapshot (H0 is a mean over 4 bins of R0/4, H_wall0 a maximum over
+          two bins of D: H_inf/H_wall0 says whether the column's top at the wall went down)
   flank   the angle of the free surface: a least-squares line through the bins where the
           deposit's monotone envelope (max of h over the bins further out) lies between 0.2 and
           0.8 H_inf; its slope -> the angle in degrees
@@ -52,7 +54,9 @@ The grain Reynolds number (Izard's "3R sphere"):
           particle snapshot at the same time (resolved runs only); its maximum over grains and
           snapshots, and the maximum at each snapshot.  Re_p_max_all: the same with U the plain
           mean of the snapshot's velocity over those cells, the solid ones included (the one-fluid
-          field of the immersed boundary, which inside a grain is the grain's velocity)
+          field of the immersed boundary, which inside a grain is the grain's velocity);
+          Re_p_p99_max and Re_p_mean_max: the largest over the snapshots of the 99th percentile and
+          of the mean over the grains (fluid-weighted U)
 Also: the largest overlap (column dem_max_overlap, of the smaller diameter), rejected_steps, the
 wall time and cost.* of summary.json when the run wrote one.  With matplotlib, RUN_DIR/column.png
 shows the front against t/sqrt(D/g) and t/T_visq, E_cx and the deposit profile.
@@ -127,7 +131,7 @@ def reynolds(d, rho, eta, D):
             wf = 1.0 - h["solid_fraction"][...]
         _, x, v, r, _, fx = load(parts[tf])
         dx, dy, dz = xc[1] - xc[0], yc[1] - yc[0], zc[1] - zc[0]
-        best = best_all = 0.0
+        res, res_all = [], []
         for c, vv, rr in zip(x[~fx], v[~fx], r[~fx]):
             R3 = 3 * rr
             ix = np.nonzero(np.abs(xc - c[0]) <= R3)[0]
@@ -149,9 +153,10 @@ def reynolds(d, rho, eta, D):
             Ub = U[np.ix_(iz, jy, ix)]
             Uf = (w[..., None] * Ub).sum((0, 1, 2)) / w.sum()
             Ua = Ub[inb].mean(0)
-            best = max(best, rho * float(np.linalg.norm(vv - Uf)) * D / eta)
-            best_all = max(best_all, rho * float(np.linalg.norm(vv - Ua)) * D / eta)
-        out.append((tf, best, best_all))
+            res.append(rho * float(np.linalg.norm(vv - Uf)) * D / eta)
+            res_all.append(rho * float(np.linalg.norm(vv - Ua)) * D / eta)
+        if res:
+            out.append((tf, max(res), max(res_all), float(np.percentile(res, 99)), float(np.mean(res))))
     return out
 
 
@@ -226,6 +231,7 @@ def main():
     # the deposit, from the last particle snapshot
     ts, xs, vs, rs, rps, fx = load(snaps[-1])
     dep = deposit(xs[~fx], rs[~fx], D, R0)
+    H_wall0 = deposit(x, r, D, R0)["H_inf"]  # the same estimator on the first snapshot
     R_inf = R0 * (1 + fronts[-1][1])
     # the stopping time
     ek = s["dem_kinetic_energy"]
@@ -267,9 +273,11 @@ def main():
         "Ecx": ecx[::max(1, len(ecx) // 200)],
         "front_t": [[a, a / tg, a / tv, b] for a, b in fronts],
         "R_inf": R_inf, "R_inf_over_R0": R_inf / R0, "H_inf_over_R0": dep["H_inf"] / R0,
-        "H_inf_over_H0": dep["H_inf"] / H0, "H_inf_over_D": dep["H_inf"] / D, "deposit_time": ts, **dep, **stop,
+        "H_inf_over_H0": dep["H_inf"] / H0, "H_wall0": H_wall0, "H_inf_over_H_wall0": dep["H_inf"] / H_wall0, "H_inf_over_D": dep["H_inf"] / D, "deposit_time": ts, **dep, **stop,
         "Re_p_max": rep[irep][1] if rep else float("nan"), "t_Re_p_max": rep[irep][0] if rep else float("nan"),
         "Re_p_max_all": max(b[2] for b in rep) if rep else float("nan"),
+        "Re_p_p99_max": max(b[3] for b in rep) if rep else float("nan"),
+        "Re_p_mean_max": max(b[4] for b in rep) if rep else float("nan"),
         "Re_p_series": rep,
         "max_overlap": float(s["dem_max_overlap"].max()) if "dem_max_overlap" in s.dtype.names else float("nan"),
         **extra,
@@ -282,13 +290,13 @@ def main():
           f"front_final={out['front_final']:.3f} Ecx_max={out['Ecx_max']:.4f}@{ecx[ie][0]:.3f}s "
           f"Tvisq={tv:.3g}s sqrt(D/g)={tg:.4f}s")
     print(f"deposit: t={ts:.3f}s R_inf/R0={R_inf / R0:.3f} H_inf/R0={out['H_inf_over_R0']:.3f} "
-          f"H_inf/H0={out['H_inf_over_H0']:.3f} flank={dep['flank_angle_deg']:.1f}deg ({dep['flank_fit_bins']} bins) "
+          f"H_inf/H0={out['H_inf_over_H0']:.3f} H_inf/H_wall0={out['H_inf_over_H_wall0']:.3f} flank={dep['flank_angle_deg']:.1f}deg ({dep['flank_fit_bins']} bins) "
           f"plateau={dep['plateau'] / D:.0f}D shape={dep['shape']} "
           f"t_stop(1e-3 Ek_max)={stop['t_stop']:.3f}s({stop['t_stop_sqrt_D_g']:.1f}sqrt(D/g),{stop['t_stop_Tvisq']:.0f}Tv"
           f"{',at the end' if stop['t_stop_at_end'] else ''}) "
           f"t_stop(1e-2)={stop['t_stop_1e-2']:.3f}s({stop['t_stop_1e-2_sqrt_D_g']:.1f}) "
           f"t_front99={stop['t_front99']:.3f}s({stop['t_front99_sqrt_D_g']:.1f}) "
-          f"Re_p_max={out['Re_p_max']:.3f}@{out['t_Re_p_max']:.3f}s(all cells {out['Re_p_max_all']:.3f}) max_overlap={out['max_overlap']:.5f}")
+          f"Re_p_max={out['Re_p_max']:.3f}@{out['t_Re_p_max']:.3f}s(all cells {out['Re_p_max_all']:.3f}; p99 {out['Re_p_p99_max']:.3f}, mean {out['Re_p_mean_max']:.3f}) max_overlap={out['max_overlap']:.5f}")
     plot(d, out, D)
 
 
