@@ -27,6 +27,39 @@ Definitions:
           their mean radius, at each particle snapshot
   E_cx    sum of m_i u_i^2/2 over the mobile grains / N, over m g D: at every series row from the
           column dem_kinetic_energy_x, else at each particle snapshot
+  front_t the front against t, t in seconds, in sqrt(D/g) and in T_visq (each particle snapshot)
+The deposit (the last particle snapshot):
+  h(x)    the deposit profile: in bins of x of one D from the wall x = 0, the top (z + r) of the
+          highest mobile grain of the bin (0 where the bin holds none), heights from the bed's
+          centres (z = 0), as H0
+  R_inf   the final front x_front (as above, not relative to R0): R_inf/R0 = 1 + front_final
+  H_inf   the final height at the wall: the larger h of the first two bins (x in [0, 2D]: the
+          grains against the wall sit lower than the next ones); H_inf/R0 and H_inf/H0; H_wall0
+          the same on the first snapshot (H0 is a mean over 4 bins of R0/4, H_wall0 a maximum over
+          two bins of D: H_inf/H_wall0 says whether the column's top at the wall went down)
+  flank   the angle of the free surface: a least-squares line through the bins where the
+          deposit's monotone envelope (max of h over the bins further out) lies between 0.2 and
+          0.8 H_inf; its slope -> the angle in degrees
+  plateau the length from the wall over which the envelope stays within D/2 of H_inf; the shape
+          is "trapezoid" when the plateau spans at least 3 D, else "triangle"
+The stopping time:
+  t_stop  the last series time at which the grains' translational kinetic energy (column
+          dem_kinetic_energy) exceeds 1e-3 of its maximum (velocities ~3 % of the peak); also
+          t_stop_1e-2 with 1e-2, and t_front99, the first particle snapshot at which the front
+          reaches 99 % of its final value; all in s, sqrt(D/g) and T_visq
+The grain Reynolds number (Izard's "3R sphere"):
+  Re_p    rho |V_p - U| D / eta with D the mean diameter and U the fluid velocity averaged over
+          the cells whose centres lie within 3R of the grain's centre, weighted by the fluid
+          fraction 1 - alpha (the grain's own cells excluded); at each fluid snapshot that has a
+          particle snapshot at the same time (resolved runs only); its maximum over grains and
+          snapshots, and the maximum at each snapshot.  Re_p_max_all: the same with U the plain
+          mean of the snapshot's velocity over those cells, the solid ones included (the one-fluid
+          field of the immersed boundary, which inside a grain is the grain's velocity);
+          Re_p_p99_max and Re_p_mean_max: the largest over the snapshots of the 99th percentile and
+          of the mean over the grains (fluid-weighted U)
+Also: the largest overlap (column dem_max_overlap, of the smaller diameter), rejected_steps, the
+wall time and cost.* of summary.json when the run wrote one.  With matplotlib, RUN_DIR/column.png
+shows the front against t/sqrt(D/g) and t/T_visq, E_cx and the deposit profile.
 """
 import configparser
 import glob
@@ -53,6 +86,78 @@ def column_height(x, r, R0):
         if sel.any():
             tops.append((x[sel, 2] + r[sel]).max())
     return float(np.mean(tops))
+
+
+def deposit(x, r, D, R0):
+    """The deposit profile h(x) in bins of one D from the wall, H_inf, the flank angle and shape."""
+    nb = int(np.ceil(x[:, 0].max() / D)) + 1
+    edges = np.arange(nb + 1) * D
+    h = np.zeros(nb)
+    top = x[:, 2] + r
+    ib = np.clip((x[:, 0] // D).astype(int), 0, nb - 1)
+    np.maximum.at(h, ib, top)
+    xc = 0.5 * (edges[:-1] + edges[1:])
+    H = float(h[:2].max())
+    env = np.maximum.accumulate(h[::-1])[::-1]  # max of h over the bins from here outwards
+    sel = (env >= 0.2 * H) & (env <= 0.8 * H)
+    if sel.sum() >= 2:
+        slope = np.polyfit(xc[sel], h[sel], 1)[0]
+        angle = float(np.degrees(np.arctan(-slope)))
+    else:
+        angle = float("nan")
+    plateau = float(D * np.argmax(env < H - 0.5 * D)) if (env < H - 0.5 * D).any() else float(edges[-1])
+    return {"profile_dx": D, "profile_x": xc.tolist(), "profile_h": h.tolist(), "H_inf": H,
+            "flank_angle_deg": angle, "flank_fit_bins": int(sel.sum()),
+            "flank_fit_x": [float(xc[sel].min()), float(xc[sel].max())] if sel.any() else [],
+            "plateau": plateau, "shape": "trapezoid" if plateau >= 3 * D else "triangle"}
+
+
+def reynolds(d, rho, eta, D):
+    """Izard's grain Reynolds number: grain velocity against the fluid's within 3R, at each fluid
+    snapshot with a particle snapshot at the same time.  Returns [(t, max Re_p)]."""
+    parts = {}
+    for p in sorted(glob.glob(os.path.join(d, "particles_*.h5"))):
+        with h5py.File(p, "r") as h:
+            parts[round(float(np.ravel(h.attrs["time"])[0]), 9)] = p
+    out = []
+    for f in sorted(glob.glob(os.path.join(d, "fields_*.h5"))):
+        with h5py.File(f, "r") as h:
+            tf = round(float(np.ravel(h.attrs["time"])[0]), 9)
+            if tf not in parts:
+                continue
+            xc, yc, zc = h["xc"][...], h["yc"][...], h["zc"][...]
+            W = float(h["y"][-1] - h["y"][0])
+            U = h["velocity"][...]          # [nz][ny][nx][3], cell centred
+            wf = 1.0 - h["solid_fraction"][...]
+        _, x, v, r, _, fx = load(parts[tf])
+        dx, dy, dz = xc[1] - xc[0], yc[1] - yc[0], zc[1] - zc[0]
+        res, res_all = [], []
+        for c, vv, rr in zip(x[~fx], v[~fx], r[~fx]):
+            R3 = 3 * rr
+            ix = np.nonzero(np.abs(xc - c[0]) <= R3)[0]
+            iz = np.nonzero(np.abs(zc - c[2]) <= R3)[0]
+            ny = len(yc)
+            j0 = int(np.floor((c[1] - R3 - yc[0]) / dy))
+            jy = np.arange(j0, int(np.ceil((c[1] + R3 - yc[0]) / dy)) + 1)
+            jy = np.unique(jy % ny) if len(jy) >= ny else jy % ny
+            if len(ix) == 0 or len(iz) == 0:
+                continue
+            qy = yc[jy] - c[1]
+            qy -= W * np.round(qy / W)
+            d2 = ((zc[iz] - c[2])[:, None, None] ** 2 + qy[None, :, None] ** 2
+                  + (xc[ix] - c[0])[None, None, :] ** 2)
+            inb = d2 <= R3 * R3
+            w = np.where(inb, wf[np.ix_(iz, jy, ix)], 0.0)
+            if w.sum() <= 0:
+                continue
+            Ub = U[np.ix_(iz, jy, ix)]
+            Uf = (w[..., None] * Ub).sum((0, 1, 2)) / w.sum()
+            Ua = Ub[inb].mean(0)
+            res.append(rho * float(np.linalg.norm(vv - Uf)) * D / eta)
+            res_all.append(rho * float(np.linalg.norm(vv - Ua)) * D / eta)
+        if res:
+            out.append((tf, max(res), max(res_all), float(np.percentile(res, 99)), float(np.mean(res))))
+    return out
 
 
 def main():
@@ -123,6 +228,38 @@ def main():
     if "dem_kinetic_energy_x" in s.dtype.names:  # every series row (the DEM's column)
         ecx = [(float(a), float(b / mob.sum() / (m * G * D))) for a, b in zip(t, s["dem_kinetic_energy_x"])]
     ie = int(np.argmax([e for _, e in ecx]))
+    # the deposit, from the last particle snapshot
+    ts, xs, vs, rs, rps, fx = load(snaps[-1])
+    dep = deposit(xs[~fx], rs[~fx], D, R0)
+    H_wall0 = deposit(x, r, D, R0)["H_inf"]  # the same estimator on the first snapshot
+    R_inf = R0 * (1 + fronts[-1][1])
+    # the stopping time
+    ek = s["dem_kinetic_energy"]
+    ikm = int(np.argmax(ek))
+    stop = {}
+    for name, frac in (("t_stop", 1e-3), ("t_stop_1e-2", 1e-2)):
+        above = np.nonzero(ek > frac * ek[ikm])[0]
+        ts_ = float(t[above[-1]]) if len(above) else float(t[0])
+        stop[name] = ts_
+        stop[name + "_sqrt_D_g"] = ts_ / tg
+        stop[name + "_Tvisq"] = ts_ / tv
+        stop[name + "_at_end"] = bool(above[-1] == len(t) - 1) if len(above) else False
+    ff = fronts[-1][1]
+    i99 = next((i for i, (_, fr) in enumerate(fronts) if ff > 0 and fr >= 0.99 * ff), len(fronts) - 1)
+    stop["t_front99"] = fronts[i99][0]
+    stop["t_front99_sqrt_D_g"] = fronts[i99][0] / tg
+    stop["t_front99_Tvisq"] = fronts[i99][0] / tv
+    # the grain Reynolds number (resolved runs)
+    rep = reynolds(d, rho, eta, D) if os.path.exists(fields) else []
+    irep = int(np.argmax([b[1] for b in rep])) if rep else None
+    extra = {}
+    sj = os.path.join(d, "summary.json")
+    if os.path.exists(sj):
+        with open(sj) as f:
+            sm = json.load(f)
+        for k in ("status", "steps", "rejected_steps", "wall_time", "steps_per_second", "last_dt", "cost"):
+            if k in sm:
+                extra[k] = sm[k]
     out = {
         "grains": int(mob.sum()), "D": D, "H0": H0, "H0_over_D": H0 / D, "R0_over_D": R0 / D, "a": H0 / R0,
         "W_over_D": W / D, "phi_mass": phi_mass, "phi_alpha": phi_alpha, "phi_inner": phi_inner, "drho_g_H0": scale,
@@ -134,6 +271,16 @@ def main():
                                                                    ps[::max(1, len(t) // 200)])],
         "front": fronts, "front_final": fronts[-1][1], "Ecx_max": ecx[ie][1], "t_Ecx_max": ecx[ie][0],
         "Ecx": ecx[::max(1, len(ecx) // 200)],
+        "front_t": [[a, a / tg, a / tv, b] for a, b in fronts],
+        "R_inf": R_inf, "R_inf_over_R0": R_inf / R0, "H_inf_over_R0": dep["H_inf"] / R0,
+        "H_inf_over_H0": dep["H_inf"] / H0, "H_wall0": H_wall0, "H_inf_over_H_wall0": dep["H_inf"] / H_wall0, "H_inf_over_D": dep["H_inf"] / D, "deposit_time": ts, **dep, **stop,
+        "Re_p_max": rep[irep][1] if rep else float("nan"), "t_Re_p_max": rep[irep][0] if rep else float("nan"),
+        "Re_p_max_all": max(b[2] for b in rep) if rep else float("nan"),
+        "Re_p_p99_max": max(b[3] for b in rep) if rep else float("nan"),
+        "Re_p_mean_max": max(b[4] for b in rep) if rep else float("nan"),
+        "Re_p_series": rep,
+        "max_overlap": float(s["dem_max_overlap"].max()) if "dem_max_overlap" in s.dtype.names else float("nan"),
+        **extra,
     }
     with open(os.path.join(d, "column.json"), "w") as f:
         json.dump(out, f, indent=1)
@@ -142,6 +289,46 @@ def main():
           f"pb_max={out['pb_max']:+.4f}@{t[imax]:.3f}s({t[imax] / tv:.0f}Tv) pb_mean={out['pb_mean']:+.4f} "
           f"front_final={out['front_final']:.3f} Ecx_max={out['Ecx_max']:.4f}@{ecx[ie][0]:.3f}s "
           f"Tvisq={tv:.3g}s sqrt(D/g)={tg:.4f}s")
+    print(f"deposit: t={ts:.3f}s R_inf/R0={R_inf / R0:.3f} H_inf/R0={out['H_inf_over_R0']:.3f} "
+          f"H_inf/H0={out['H_inf_over_H0']:.3f} H_inf/H_wall0={out['H_inf_over_H_wall0']:.3f} flank={dep['flank_angle_deg']:.1f}deg ({dep['flank_fit_bins']} bins) "
+          f"plateau={dep['plateau'] / D:.0f}D shape={dep['shape']} "
+          f"t_stop(1e-3 Ek_max)={stop['t_stop']:.3f}s({stop['t_stop_sqrt_D_g']:.1f}sqrt(D/g),{stop['t_stop_Tvisq']:.0f}Tv"
+          f"{',at the end' if stop['t_stop_at_end'] else ''}) "
+          f"t_stop(1e-2)={stop['t_stop_1e-2']:.3f}s({stop['t_stop_1e-2_sqrt_D_g']:.1f}) "
+          f"t_front99={stop['t_front99']:.3f}s({stop['t_front99_sqrt_D_g']:.1f}) "
+          f"Re_p_max={out['Re_p_max']:.3f}@{out['t_Re_p_max']:.3f}s(all cells {out['Re_p_max_all']:.3f}; p99 {out['Re_p_p99_max']:.3f}, mean {out['Re_p_mean_max']:.3f}) max_overlap={out['max_overlap']:.5f}")
+    plot(d, out, D)
+
+
+def plot(d, out, D):
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return
+    ft = np.array(out["front_t"])
+    fig, ax = plt.subplots(2, 2, figsize=(10, 7))
+    ax[0, 0].plot(ft[:, 1], ft[:, 3], "o-", ms=3)
+    ax[0, 0].set_xlabel("t / sqrt(D/g)")
+    ax[0, 0].set_ylabel("(x_f - R0)/R0")
+    ax[0, 1].plot(ft[:, 2], ft[:, 3], "o-", ms=3)
+    ax[0, 1].set_xlabel("t / T_visq")
+    ax[0, 1].set_ylabel("(x_f - R0)/R0")
+    e = np.array(out["Ecx"])
+    ax[1, 0].plot(e[:, 0] / out["sqrt_D_over_g"], e[:, 1])
+    ax[1, 0].set_xlabel("t / sqrt(D/g)")
+    ax[1, 0].set_ylabel("E_cx / (m g D)")
+    ax[1, 1].step(np.array(out["profile_x"]) / D, np.array(out["profile_h"]) / D, where="mid")
+    ax[1, 1].axhline(out["H0"] / D, ls=":", c="k")
+    ax[1, 1].axvline(out["R0_over_D"], ls=":", c="k")
+    ax[1, 1].set_aspect("equal")
+    ax[1, 1].set_xlabel("x / D")
+    ax[1, 1].set_ylabel("h / D")
+    ax[1, 1].set_title(f"{out['shape']}, flank {out['flank_angle_deg']:.1f} deg", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(os.path.join(d, "column.png"), dpi=90)
+    plt.close(fig)
 
 
 if __name__ == "__main__":

@@ -14,6 +14,12 @@
 #     the band (1.5 %) is half the dense extreme and a third of the loose one.  What the signals do afterwards is
 #     printed, not asserted: at this size (88 grains) the loose signal changes sign within
 #     0.05 s and the dense one ends with a positive pulse (README.md, "Measured").
+#  3. the dense column's deposit at t = 0.6 s (15 sqrt(D/g), the last particle snapshot; still
+#     creeping): the front has moved (R_inf/R0 > 1.2), the height at the wall has not grown
+#     (H_inf <= its value at t = 0 + D/4), the flank angle (a line through the profile between 0.2 and 0.8 H_inf)
+#     lies in 10-35 degrees, and the column keeps a plateau at the wall (a trapezoid, Rondon et
+#     al. 2011 for Phi_i = 0.6, a = 0.5).  Measured: R_inf/R0 = 1.452, H_inf/H0 = 1.000,
+#     19.0 degrees, a plateau of 5 D; the maximum grain Reynolds number (3R sphere) 4.2.
 # The magnitudes over Delta rho g H0, the times in T_visq = eta/(Delta rho g H0) and the initial
 # solid fractions are printed (postproc/column_collapse.py).
 . "$(dirname "$0")/tap.sh"
@@ -70,4 +76,18 @@ for k in ("dense", "loose"):
 sys.exit(0 if sign["dense"] < 0 and sign["loose"] > 0 else 1)
 PY
 report $? "basal pore pressure after the gate opens: first below hydrostatic (dense), above (loose)"
+$PY - $T <<'PY'
+import json, sys
+T = sys.argv[1]
+j = json.load(open(f"{T}/dense/column.json"))
+D = j["D"]
+print(f"# dense deposit at t = {j['deposit_time']:.3f} s: R_inf/R0 = {j['R_inf_over_R0']:.3f}, H_inf/H0 = {j['H_inf_over_H0']:.3f} (at t = 0: {j['H_wall0'] / j['H0']:.3f}), "
+      f"H_inf/R0 = {j['H_inf_over_R0']:.3f}, flank {j['flank_angle_deg']:.1f} deg, plateau {j['plateau'] / D:.0f} D ({j['shape']}); "
+      f"Re_p max {j['Re_p_max']:.2f} at {j['t_Re_p_max']:.3f} s; t_stop (1e-3 of the peak kinetic energy) {j['t_stop']:.3f} s"
+      f"{' (still moving at the end)' if j['t_stop_at_end'] else ''}")
+ok = (j["R_inf_over_R0"] > 1.2 and j["H_inf"] <= j["H_wall0"] + 0.25 * D and 10 <= j["flank_angle_deg"] <= 35
+      and j["shape"] == "trapezoid")
+sys.exit(0 if ok else 1)
+PY
+report $? "dense deposit: the front moved, the wall height did not grow, flank 10-35 degrees, a trapezoid"
 tap_end $T
