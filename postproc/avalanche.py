@@ -49,6 +49,10 @@ def merge_diameter(rows, D):
     return out
 
 
+def inf(x):
+    return float("inf") if x is None else x
+
+
 def summarise(run):
     s = json.load(open(os.path.join(run, "summary.json")))
     a = s["avalanche"]
@@ -56,9 +60,10 @@ def summarise(run):
     row = {
         "run": os.path.basename(os.path.normpath(run)),
         "ratio": a["density_ratio"], "St": a["St"], "r": a["r"], "Ar": a["Ar"],
-        "T_ms": 1e3 * a["T"] if a["T"] is not None else float("nan"),
-        "T_g": a["T"] / tg if a["T"] is not None else float("nan"),
-        "T_Tv": a["T_over_Tv"], "T_Ti": a["T_over_Ti"], "T_Tff": a["T_over_Tff"],
+        "T_ms": 1e3 * a["T"] if a["T"] is not None else float("inf"),
+        "T_g": a["T"] / tg if a["T"] is not None else float("inf"),
+        # a bed that did not move over the window has no flow rate: T is infinite
+        "T_Tv": inf(a["T_over_Tv"]), "T_Ti": inf(a["T_over_Ti"]), "T_Tff": inf(a["T_over_Tff"]),
         "phi": a["mean"]["phi_bed"], "h_D": a["mean"]["h_g"] / a["D"],
         "St_mean": a["mean"]["St_mean"],
         "share_c": a["share_per_contact"], "share_g": a["share_per_grain"],
@@ -85,6 +90,8 @@ THESIS = {(4, 0.04): "viscous", (4, 0.31): "viscous", (4, 7.75): "inertial", (4,
 # The band of a plateau: the thesis' viscous plateau scatters up to T/T_v = 1.95 (Table 4.2 read with
 # its T_v at rho_p/rho = 40 and 100, reference notes §2.1)
 BAND = 2.0
+# a bed slower than every time scale by this factor has stopped or creeps (not a regime)
+NOFLOW = 20.0
 
 
 def regime(r):
@@ -96,6 +103,8 @@ def regime(r):
     d = {"viscous": abs(math.log(r["T_Tv"])), "inertial": abs(math.log(r["T_Ti"])),
          "free fall": abs(math.log(r["T_Tff"]))}
     best = min(d, key=d.get)
+    if min(r["T_Tv"], r["T_Ti"], r["T_Tff"]) > NOFLOW:
+        return "no flow"
     return best if d[best] <= math.log(BAND) else "transitional"
 
 
@@ -139,7 +148,10 @@ def table42(rows):
         (s0, s1), (t0, t1) = row
         ins = "yes" if t0 <= t <= t1 else ("below" if t < t0 else "above")
         sin = "" if s0 <= r["St"] * 1.05 and r["St"] <= s1 * 1.05 else " (St outside the row's)"
-        out.append("| %s | %.3g | %.1f | %g–%g, %g–%g | %s%s |" % (r["run"], r["St"], t, s0, s1, t0, t1, ins, sin))
+        ts = "%.1f" % t
+        if regime(r) == "no flow":
+            ts, ins = "no flow", "no"
+        out.append("| %s | %.3g | %s | %g–%g, %g–%g | %s%s |" % (r["run"], r["St"], ts, s0, s1, t0, t1, ins, sin))
     return "\n".join(out) + "\n"
 
 
@@ -207,7 +219,7 @@ def main():
         s = json.load(open(os.path.join(r, "summary.json")))
         av = s["avalanche"]
         note = "%s at %.1f √(D/g) (%s)" % (s["status"], s["time"] / av["sqrt_D_over_g"], s.get("reason", ""))
-        if av.get("T") is None or not av.get("averaged_seconds"):
+        if not av.get("averaged_seconds") or (av.get("T") is None and s["status"] != "t_end"):
             stopped.append("%s: no flow time, %s" % (os.path.basename(r), note))
         else:
             keep.append(r)
@@ -236,7 +248,7 @@ def main():
     if a.map:
         fig, ax = plt.subplots(figsize=(6, 4.5))
         mk = {"viscous": ("o", "tab:blue"), "inertial": ("s", "tab:orange"), "free fall": ("^", "tab:green"),
-              "transitional": ("D", "0.6")}
+              "transitional": ("D", "0.6"), "no flow": ("x", "k")}
         for lab, (m, c) in mk.items():
             pts = [(r["St"], r["r"]) for r in rows if regime(r) == lab]
             if pts:
@@ -251,11 +263,14 @@ def main():
             th = next((v for (q, st), v in THESIS.items() if abs(r["ratio"] - q) < 1e-6 * q and abs(r["St"] / st - 1) < 0.05),
                       None)
             if th:
-                ax.annotate(th, (r["St"], r["r"]), textcoords="offset points", xytext=(4, 4), fontsize=6, color="0.3")
+                ax.annotate("thesis: " + th, (r["St"], r["r"]), textcoords="offset points", xytext=(4, 4), fontsize=6,
+                            color="0.3")
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.set_xlim(0.02, 1e3)
         ax.set_xlabel("St")
         ax.set_ylabel("r")
+        ax.set_title("labels by the flow time's scale (T/T_v, T/T_i, T/T_ff within 2)", fontsize=8)
         ax.legend(fontsize=7)
         fig.tight_layout()
         fig.savefig(a.out + "_map.png", dpi=100)
@@ -263,6 +278,8 @@ def main():
         # for St >= 1 (Fig. 4.8)
         fig, ax = plt.subplots(1, 2, figsize=(9, 4))
         for lab, (m, c) in mk.items():
+            if lab == "no flow":
+                continue
             pts = [(r["St"], r["T_Tv"]) for r in rows if regime(r) == lab]
             if pts:
                 ax[0].scatter(*zip(*pts), marker=m, color=c, label=lab)
@@ -273,7 +290,7 @@ def main():
         ax[0].set_xlabel("St")
         ax[0].set_ylabel("T/T_v")
         ax[0].legend(fontsize=7)
-        big = [r for r in rows if r["St"] >= 1]
+        big = [r for r in rows if r["St"] >= 1 and regime(r) != "no flow"]
         if big:
             ax[1].scatter([r["r"] for r in big], [r["T_Ti"] for r in big], marker="s", color="tab:orange", label="T/T_i")
             ax[1].scatter([r["r"] for r in big], [r["T_Tff"] for r in big], marker="^", color="tab:green", label="T/T_ff")
