@@ -246,7 +246,7 @@ def main():
     except ImportError:
         return
     if a.map:
-        fig, ax = plt.subplots(figsize=(6, 4.5))
+        fig, ax = plt.subplots(figsize=(8.5, 4.5))
         mk = {"viscous": ("o", "tab:blue"), "inertial": ("s", "tab:orange"), "free fall": ("^", "tab:green"),
               "transitional": ("D", "0.6"), "no flow": ("x", "k")}
         for lab, (m, c) in mk.items():
@@ -271,7 +271,7 @@ def main():
         ax.set_xlabel("St")
         ax.set_ylabel("r")
         ax.set_title("labels by the flow time's scale (T/T_v, T/T_i, T/T_ff within 2)", fontsize=8)
-        ax.legend(fontsize=7)
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1))
         fig.tight_layout()
         fig.savefig(a.out + "_map.png", dpi=100)
         # the thesis' classification plots: T/T_v against St (Fig. 4.7), T/T_i and T/T_ff against r
