@@ -228,6 +228,11 @@ void dem_write_snapshot(dem_t *d, const char *dir, int index);
  * file is a checkpoint.  dem_read_checkpoint replaces the particles. */
 void dem_write_checkpoint(dem_t *d, const char *path);
 void dem_read_checkpoint(dem_t *d, const char *path);
+/* The particles of a packing, snapshot or checkpoint as the start of a new run ([particles]
+ * source = file): as dem_read_checkpoint, but the walls stay where the case put them (point,
+ * activity, velocity, load); where the file has them elsewhere, the lists are built for the
+ * case's walls and the file's wall springs are dropped. */
+void dem_read_particles_file(dem_t *d, const char *path);
 /* The same into / from an open HDF5 file or group (a part of a run checkpoint). */
 void dem_checkpoint_write_loc(dem_t *d, hid_t loc);
 void dem_checkpoint_read_loc(dem_t *d, hid_t loc, const char *path);

@@ -32,11 +32,6 @@ table43="4:0.04 4:0.31 4:7.75 4:75.4 100:0.45 100:4.5 100:111.2"
 # them, v t_c/pi passes 1 % of D at impacts of 1.6 m/s, which the fastest flows reach: a run stops at
 # 3 % (not the target's 1 %, which each run's table row is read against: its largest overlap).
 STIFF="--set contact.contact_time=9.93e-5 --set dem.max_overlap=0.03"
-# The quick bed (coarse_bed.h5) was settled in a 30 D tall box and carries its DEM lid (the z_hi face
-# wall) at z = 0.15 m, which a run reading it keeps: in coarse.ini's 12 D box the grains of a fast,
-# dilated flow reach the fluid's lid at 0.06 m with no DEM wall there and the run stops (Table 4.3's
-# case 4 at 110 sqrt(D/g)).  The map puts a DEM wall on the fluid's lid.
-LID="--set walls.wall1_point=0,0,0.06 --set walls.wall1_normal=0,0,-1"
 run_set() { # SET CASE T_END_G AVG_FROM_G "RATIO:ST ..." [--set options of every run]
     local set=$1 case=$2 tend=$3 avg=$4 list=$5 extra=${6:-} dirs=() pids=()
     for rs in $list; do
@@ -75,9 +70,9 @@ map | all)
     if [ -z "$grid" ]; then
         for r in 2.7 4 10 40 100; do for s in 0.05 0.3 1 4.5 20 100; do grid="$grid $r:$s"; done; done
     fi
-    run_set map cases/avalanche/coarse.ini 300 150 "$table43 $grid" "$STIFF $LID" ;;&
+    run_set map cases/avalanche/coarse.ini 300 150 "$table43 $grid" "$STIFF" ;;&
 table)
-    run_set table cases/avalanche/coarse.ini 300 150 "$table43" "$STIFF $LID" ;;
+    run_set table cases/avalanche/coarse.ini 300 150 "$table43" "$STIFF" ;;
 production | all)
     run_set production cases/avalanche/case.ini 300 200 "$table43" ;;
 post)

@@ -16,8 +16,9 @@
 #     window writes the same profiles.csv and series.csv, and the same averages in summary.json.
 #  4. the viscous plateau: from a flowing state (cases/avalanche/coarse_flowing.h5, the quick bed
 #     after 300 sqrt(D/g) of case 2; the fluid starts at rest), 30 sqrt(D/g) more, averaged over
-#     the last 20: T/T_v within the issue's band 0.7–1.5 (thesis 1.03–1.10; measured 1.39 here,
-#     1.34 over 150–300 sqrt(D/g) of the run that made the state).
+#     the last 20: T/T_v within the issue's band 0.7–1.5 (thesis 1.03–1.10; measured 1.44 here,
+#     1.34 over 150–300 sqrt(D/g) of the run that made the state);
+#  5. the bed's file does not move the case's walls (the DEM lid stays at the fluid's lid).
 # The triggering itself (~70 sqrt(D/g) in this box) is for make avalanche.  Prints TAP lines; ~50 s.
 . "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_avalanche.XXXXXX)
@@ -73,5 +74,17 @@ rf=$?
 read sf of qf lf tf <<<"$(stat $T/flow 2>/dev/null)"
 [ $rf = 0 ] && [ "$sf" = t_end ] && $PY -c "import sys; sys.exit(not 0.7 <= $tf <= 1.5)"
 report $? "viscous plateau from a flowing bed (case 2, 10-30 sqrt(D/g)): T/T_v = ${tf}"
+
+# 5. a run that reads a bed keeps its own case's walls: coarse_bed.h5 was settled under a DEM lid at
+#    0.15 m, coarse.ini's lid (the fluid's) is at 0.06 m, and the DEM's z_hi wall must be there
+$PY - $T/visc/checkpoint_00000040.h5 <<'PY'
+import sys
+import h5py
+with h5py.File("cases/avalanche/coarse_bed.h5", "r") as b, h5py.File(sys.argv[1], "r") as c:
+    zb, zc = b["wall_z_hi"].attrs["point"][2], c["dem/wall_z_hi"].attrs["point"][2]
+print("# DEM lid: %g m in the bed's file, %g m in the run" % (zb, zc))
+sys.exit(not (zb == 0.15 and zc == 0.06))
+PY
+report $? "a bed read from a file takes the case's walls: the DEM lid at the fluid's 0.06 m (the file's 0.15 m)"
 
 tap_end $T

@@ -104,7 +104,8 @@ static void test_velocity_history(void **state)
     remove(path); /* each rank wrote its own file */
 }
 
-/* Forcing iterations: the projection after a forcing gives back part of
+/* Forcing iterations (the seed's forcing, applied after the solve, as the
+ * iterations are): the projection after a forcing gives back part of
  * the velocity inside a sphere; each extra (force, project) pass removes
  * more of it.  A fixed disc in a uniform stream (2-D): the largest |u| left
  * at the nodes where α = 1 after one step falls with the iterations. */
@@ -113,7 +114,8 @@ static double interior_slip(int iterations)
     char text[1024];
     snprintf(text, sizeof text,
              "[domain]\ngeometry = 2d\nnx = 32\nny = 32\nlength = 4 4 1\n[fluid]\nnu = 0.1\ndt = 0.02\n"
-             "[ibm]\nforcing_iterations = %d\nsphere1 = fixed center 2 2 0 radius 0.6\n",
+             "[ibm]\nforcing_iterations = %d\nforcing_time = 0\ncn_forcing = after_solve\n"
+             "sphere1 = fixed center 2 2 0 radius 0.6\n",
              iterations);
     it_case_t tc = it_from_case(text);
     const grid_t *g = tc.g;

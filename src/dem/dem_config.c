@@ -325,7 +325,7 @@ void dem_config_particles(dem_t *d, cfg_t *cfg)
         if (H5Aexists(f, "time") <= 0) cfg_fail(cfg, "particles", "file", "%s: no attribute time", path);
         check_file_particles(d, cfg, f, path, np);
         H5Fclose(f);
-        dem_read_checkpoint(d, path);
+        dem_read_particles_file(d, path);
         /* a new run starts its clock at 0 (a restart reads its checkpoint's
          * own DEM state, not this file): a file written at t > 0, e.g. the
          * last particle snapshot of a settling run, is the state at t = 0 */

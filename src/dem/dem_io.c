@@ -452,14 +452,50 @@ static int read_exact_lists(dem_t *d, hid_t f)
     return 1;
 }
 
+static void checkpoint_read(dem_t *d, hid_t f, const char *path, int keep_walls);
+
 void dem_read_checkpoint(dem_t *d, const char *path)
 {
     hid_t f = open_file(d, path, 0);
-    dem_checkpoint_read_loc(d, f, path);
+    checkpoint_read(d, f, path, 0);
     H5Fclose(f);
 }
 
-void dem_checkpoint_read_loc(dem_t *d, hid_t f, const char *path)
+void dem_read_particles_file(dem_t *d, const char *path)
+{
+    hid_t f = open_file(d, path, 0);
+    checkpoint_read(d, f, path, 1);
+    H5Fclose(f);
+}
+
+void dem_checkpoint_read_loc(dem_t *d, hid_t f, const char *path) { checkpoint_read(d, f, path, 0); }
+
+/* The motion of the walls as the case set it (keep_walls) */
+typedef struct {
+    double p[3], vel[3], push, mass, force[3];
+    int active;
+} wall_motion_t;
+
+/* Does the file hold a wall of this scene elsewhere (point or activity) than the scene has it? */
+static int file_walls_differ(const dem_t *d, hid_t f)
+{
+    for (int w = 0; w < d->nwall; w++) {
+        char name[64];
+        snprintf(name, sizeof name, "wall_%s", d->wall[w].name);
+        if (!has_ds(f, name)) return 1;
+        hid_t g = H5Gopen2(f, name, H5P_DEFAULT);
+        double p[3] = {0, 0, 0}, act = 1;
+        read_attr_d(g, "point", p);
+        read_attr_d(g, "active", &act);
+        H5Gclose(g);
+        if (p[0] != d->wall[w].p[0] || p[1] != d->wall[w].p[1] || p[2] != d->wall[w].p[2] ||
+            (act != 0) != (d->wall[w].active != 0))
+            return 1;
+    }
+    return 0;
+}
+
+static void checkpoint_read(dem_t *d, hid_t f, const char *path, int keep_walls)
 {
     const long n = ds_length(f, "radius");
     double *x = malloc((3 * (size_t)n + 1) * sizeof(double)), *v = malloc((3 * (size_t)n + 1) * sizeof(double)),
@@ -500,7 +536,26 @@ void dem_checkpoint_read_loc(dem_t *d, hid_t f, const char *path)
     dem_check_scene(d);
     dem_decide_split(d);
     if (d->dt <= 0 && dem_set_dt(d) != DEM_OK) die("dem: %s", d->errmsg);
-    if (read_exact_lists(d, f)) goto forces;
+    /* a new run from a file keeps the walls of its case (a bed settled in a taller box gets this
+     * case's lid); where they are not the file's, the lists are built for them and the wall
+     * springs of the file are dropped (the pair springs are kept) */
+    wall_motion_t *keep = NULL;
+    int walls_moved = 0;
+    if (keep_walls) {
+        keep = xcalloc((size_t)d->nwall + 1, sizeof *keep);
+        for (int w = 0; w < d->nwall; w++) {
+            const dem_wall_t *W = &d->wall[w];
+            wall_motion_t *k = &keep[w];
+            memcpy(k->p, W->p, sizeof k->p);
+            memcpy(k->vel, W->vel, sizeof k->vel);
+            memcpy(k->force, W->force, sizeof k->force);
+            k->push = W->push;
+            k->mass = W->mass;
+            k->active = W->active;
+        }
+        walls_moved = file_walls_differ(d, f);
+    }
+    if (!walls_moved && read_exact_lists(d, f)) goto forces;
     dem_neigh_build(d);
     long *sorted = malloc(((size_t)n + 1) * sizeof(long));
     int *index_of = malloc(((size_t)n + 1) * sizeof(int));
@@ -548,8 +603,8 @@ void dem_checkpoint_read_loc(dem_t *d, hid_t f, const char *path)
         snprintf(name, sizeof name, "wall_%s", W->name);
         if (!has_ds(f, name)) continue;
         hid_t g = H5Gopen2(f, name, H5P_DEFAULT);
-        read_wall_motion(g, W);
-        const long nw = ds_length(g, "ids");
+        if (!keep_walls) read_wall_motion(g, W);
+        const long nw = walls_moved ? 0 : ds_length(g, "ids");
         long *wid = malloc(((size_t)nw + 1) * sizeof(long));
         double *wxi = malloc((3 * (size_t)nw + 1) * sizeof(double));
         if (nw > 0) {
@@ -597,6 +652,19 @@ forces:
     free(rho);
     free(ids);
     free(fx);
+    if (keep) {
+        for (int w = 0; w < d->nwall; w++) {
+            dem_wall_t *W = &d->wall[w];
+            const wall_motion_t *k = &keep[w];
+            memcpy(W->p, k->p, sizeof k->p);
+            memcpy(W->vel, k->vel, sizeof k->vel);
+            memcpy(W->force, k->force, sizeof k->force);
+            W->push = k->push;
+            W->mass = k->mass;
+            W->active = k->active;
+        }
+        free(keep);
+    }
     if (d->drag.on && has_ds(f, "drag_fraction")) {
         /* by particle id: as many as the writer's ids (this run's next_id may be larger) */
         hid_t a = H5Aopen(f, "drag_fraction_step", H5P_DEFAULT);
