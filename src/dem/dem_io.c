@@ -381,8 +381,9 @@ static void read_wall_motion(hid_t g, dem_wall_t *W)
 }
 
 /* The neighbour and wall lists saved by dem_checkpoint_write_loc, if the
- * scene matches (same particles in the same order, skin, walls); 0 if not. */
-static int read_exact_lists(dem_t *d, hid_t f)
+ * scene matches (same particles in the same order, skin, walls); 0 if not.
+ * keep_walls: the walls' motion stays the scene's (a new run from a file). */
+static int read_exact_lists(dem_t *d, hid_t f, int keep_walls)
 {
     if (!has_ds(f, "list_start") || ds_length(f, "list_start") != d->n + 1) return 0;
     double lattr[3];
@@ -427,7 +428,7 @@ static int read_exact_lists(dem_t *d, hid_t f)
         char name[64];
         snprintf(name, sizeof name, "wall_%s", W->name);
         hid_t g = H5Gopen2(f, name, H5P_DEFAULT);
-        read_wall_motion(g, W);
+        if (!keep_walls) read_wall_motion(g, W);
         read_attr_d(g, "list_moved", &W->moved);
         const long nl = ds_length(g, "list_idx");
         if (nl > W->cap) {
@@ -469,12 +470,6 @@ void dem_read_particles_file(dem_t *d, const char *path)
 }
 
 void dem_checkpoint_read_loc(dem_t *d, hid_t f, const char *path) { checkpoint_read(d, f, path, 0); }
-
-/* The motion of the walls as the case set it (keep_walls) */
-typedef struct {
-    double p[3], vel[3], push, mass, force[3];
-    int active;
-} wall_motion_t;
 
 /* Does the file hold a wall of this scene elsewhere (point or activity) than the scene has it? */
 static int file_walls_differ(const dem_t *d, hid_t f)
@@ -539,23 +534,8 @@ static void checkpoint_read(dem_t *d, hid_t f, const char *path, int keep_walls)
     /* a new run from a file keeps the walls of its case (a bed settled in a taller box gets this
      * case's lid); where they are not the file's, the lists are built for them and the wall
      * springs of the file are dropped (the pair springs are kept) */
-    wall_motion_t *keep = NULL;
-    int walls_moved = 0;
-    if (keep_walls) {
-        keep = xcalloc((size_t)d->nwall + 1, sizeof *keep);
-        for (int w = 0; w < d->nwall; w++) {
-            const dem_wall_t *W = &d->wall[w];
-            wall_motion_t *k = &keep[w];
-            memcpy(k->p, W->p, sizeof k->p);
-            memcpy(k->vel, W->vel, sizeof k->vel);
-            memcpy(k->force, W->force, sizeof k->force);
-            k->push = W->push;
-            k->mass = W->mass;
-            k->active = W->active;
-        }
-        walls_moved = file_walls_differ(d, f);
-    }
-    if (!walls_moved && read_exact_lists(d, f)) goto forces;
+    const int walls_moved = keep_walls && file_walls_differ(d, f);
+    if (!walls_moved && read_exact_lists(d, f, keep_walls)) goto forces;
     dem_neigh_build(d);
     long *sorted = malloc(((size_t)n + 1) * sizeof(long));
     int *index_of = malloc(((size_t)n + 1) * sizeof(int));
@@ -652,19 +632,6 @@ forces:
     free(rho);
     free(ids);
     free(fx);
-    if (keep) {
-        for (int w = 0; w < d->nwall; w++) {
-            dem_wall_t *W = &d->wall[w];
-            const wall_motion_t *k = &keep[w];
-            memcpy(W->p, k->p, sizeof k->p);
-            memcpy(W->vel, k->vel, sizeof k->vel);
-            memcpy(W->force, k->force, sizeof k->force);
-            W->push = k->push;
-            W->mass = k->mass;
-            W->active = k->active;
-        }
-        free(keep);
-    }
     if (d->drag.on && has_ds(f, "drag_fraction")) {
         /* by particle id: as many as the writer's ids (this run's next_id may be larger) */
         hid_t a = H5Aopen(f, "drag_fraction_step", H5P_DEFAULT);
