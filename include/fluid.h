@@ -162,10 +162,6 @@ double fluid_max_divergence(const fluid_t *f);
 /* Volume-weighted mean of velocity component c over the box (all ranks): along
  * a periodic direction, the flux per unit cross-section (superficial velocity). */
 double fluid_mean_velocity(const fluid_t *f, int c);
-/* prm.hold_flow: set the superficial velocity along prm.hold_dir to
- * prm.hold_velocity by a uniform correction and add the corresponding
- * acceleration to prm.body_force (called by fluid_step after its last stage). */
-void fluid_hold_flow_rate(fluid_t *f, double dt);
 
 /* The discrete operators, for the tests and for other modules.  u must have
  * valid ghosts (fluid_apply_bc); each writes the unknowns of out[c] only.

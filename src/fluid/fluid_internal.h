@@ -127,4 +127,9 @@ void fluid_div_cfl_rest(const fluid_t *f, double *m);
 /* step.c */
 void fluid_project_stage(fluid_t *f, double dt_stage, int update_pressure, double *stats);
 
+/* prm.hold_flow: set the superficial velocity along prm.hold_dir to
+ * prm.hold_velocity by a uniform correction and add the corresponding
+ * acceleration to prm.body_force (called by fluid_step after its last stage). */
+void fluid_hold_flow_rate(fluid_t *f, double dt);
+
 #endif
