@@ -49,7 +49,7 @@ BIN     := $(BUILD)/ibmdem
 TESTS   := $(patsubst tests/%.c,$(BUILD)/tests/%,$(wildcard tests/test_*.c))
 BENCHES := $(patsubst bench/%.c,$(BUILD)/bench/%,$(wildcard bench/bench_*.c))
 
-.PHONY: all test demo validate bench deps clean restitution viscous_stability bounce fuzz avalanche avalanche_production crosscheck
+.PHONY: all test demo validate bench deps clean restitution viscous_stability bounce fuzz avalanche avalanche_production crosscheck collapse
 all: $(BIN) $(TESTS) $(BENCHES)
 
 $(BUILD)/obj/%.o: src/%.c
@@ -131,6 +131,11 @@ avalanche: deps
 avalanche_production: deps
 	@$(MAKE) --no-print-directory all
 	@BUILD=$(BUILD) bash scripts/avalanche.sh $(BUILD)/avalanche production
+# the immersed column collapse, Table 5.1 cases A, D, E, F at D/dx = 10 on NP = 2 ranks and A, F with the
+# pore network: build/collapse/{collapse.md,collapse.png} with issue 20's targets (scripts/collapse.sh)
+collapse: deps
+	@$(MAKE) --no-print-directory all
+	@BUILD=$(BUILD) bash scripts/collapse.sh $(BUILD)/collapse all
 # the bouncing sphere against the experiments of Gondret et al. (2002), the lubrication cut-off and the
 # oblique bounces (part of make validate); FULL=1 adds D/dx = 40 (and 30 at St 152): about 3 hours
 bounce: deps

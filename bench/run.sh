@@ -5,7 +5,7 @@
 # the load average, since a busy machine skews wall times).
 #
 #   ONLY=regex   run only the sections whose name matches (fluid, poisson,
-#                multigrid, porenet, dry, dem, ibm, steady)
+#                multigrid, porenet, dry, dem, ibm, steady, collapse)
 #   N=64         grid size of the fluid/Poisson benches (default 128)
 #   FFTW_WISDOM  wisdom file of the measuring planner (default $BUILD/bench_results/fftw.wisdom)
 #   Builds nothing (`make bench` builds first).
@@ -65,6 +65,10 @@ fi
 if want steady; then
     # a steady flow past a sphere array: explicit path against the held flow rate with Crank-Nicolson steps
     run steady bash bench/steady_path.sh
+fi
+if want collapse; then
+    # the coupled step of the column collapse (case A) against the fluid step alone, one rank
+    run collapse_step bash bench/collapse_step.sh
 fi
 if want dem; then
     # ibmdem against LIGGGHTS on ../shared/bench/dem (installs liggghts; long)

@@ -57,6 +57,10 @@ The grain Reynolds number (Izard's "3R sphere"):
           field of the immersed boundary, which inside a grain is the grain's velocity);
           Re_p_p99_max and Re_p_mean_max: the largest over the snapshots of the 99th percentile and
           of the mean over the grains (fluid-weighted U)
+The pressure signal's shape: pb_first, t_pb_first: the first value of the smoothed p_b beyond
+1.5 % of Delta rho g H0 (its sign: below or above hydrostatic first) and its time; pb_end: the
+smoothed p_b at the end of the run.  t_front_start: the time at which the front has moved 0.05 R0
+(linear between particle snapshots; None if it never does).
 Also: the largest overlap (column dem_max_overlap, of the smaller diameter), rejected_steps, the
 wall time and cost.* of summary.json when the run wrote one.  With matplotlib, RUN_DIR/column.png
 shows the front against t/sqrt(D/g) and t/T_visq, E_cx and the deposit profile.
@@ -217,6 +221,8 @@ def main():
     pad = np.pad(pb, k // 2, mode="edge")
     ps = np.convolve(pad, np.ones(k) / k, mode="valid")
     imin, imax = int(np.argmin(ps)), int(np.argmax(ps))
+    beyond = np.nonzero(np.abs(ps) > 0.015 * scale)[0]  # the first excursion beyond 1.5 % (the test's)
+    ifirst = int(beyond[0]) if len(beyond) else None
 
     fronts, ecx = [], []
     for p in snaps:
@@ -228,6 +234,12 @@ def main():
     if "dem_kinetic_energy_x" in s.dtype.names:  # every series row (the DEM's column)
         ecx = [(float(a), float(b / mob.sum() / (m * G * D))) for a, b in zip(t, s["dem_kinetic_energy_x"])]
     ie = int(np.argmax([e for _, e in ecx]))
+    # the front's start: the time it passes 0.05 R0 beyond its position at t = 0 (linear between snapshots)
+    t_start = None
+    for (ta, fa), (tb, fb) in zip(fronts, fronts[1:]):
+        if fb - fronts[0][1] >= 0.05:
+            t_start = float(ta + (tb - ta) * (0.05 + fronts[0][1] - fa) / (fb - fa)) if fb > fa else float(tb)
+            break
     # the deposit, from the last particle snapshot
     ts, xs, vs, rs, rps, fx = load(snaps[-1])
     dep = deposit(xs[~fx], rs[~fx], D, R0)
@@ -257,7 +269,7 @@ def main():
     if os.path.exists(sj):
         with open(sj) as f:
             sm = json.load(f)
-        for k in ("status", "steps", "rejected_steps", "wall_time", "steps_per_second", "last_dt", "cost"):
+        for k in ("status", "ranks", "steps", "rejected_steps", "wall_time", "steps_per_second", "last_dt", "cost"):
             if k in sm:
                 extra[k] = sm[k]
     out = {
@@ -266,12 +278,16 @@ def main():
         "T_visq": tv, "sqrt_D_over_g": tg, "probes": cols, "smooth": smooth,
         "pb_min": float(ps[imin] / scale), "t_pb_min": float(t[imin]), "t_pb_min_Tvisq": float(t[imin] / tv),
         "pb_max": float(ps[imax] / scale), "t_pb_max": float(t[imax]), "t_pb_max_Tvisq": float(t[imax] / tv),
-        "pb_mean": float(pb.mean() / scale),
+        "pb_mean": float(pb.mean() / scale), "pb_end": float(ps[-1] / scale),
+        "pb_first": float(ps[ifirst] / scale) if ifirst is not None else 0.0,
+        "t_pb_first": float(t[ifirst]) if ifirst is not None else None,
+        "t_pb_first_Tvisq": float(t[ifirst] / tv) if ifirst is not None else None,
         "pb_series": [[float(a), float(b / scale)] for a, b in zip(t[::max(1, len(t) // 200)],
                                                                    ps[::max(1, len(t) // 200)])],
         "front": fronts, "front_final": fronts[-1][1], "Ecx_max": ecx[ie][1], "t_Ecx_max": ecx[ie][0],
         "Ecx": ecx[::max(1, len(ecx) // 200)],
         "front_t": [[a, a / tg, a / tv, b] for a, b in fronts],
+        "t_front_start": t_start, "t_front_start_sqrt_D_g": t_start / tg if t_start is not None else None,
         "R_inf": R_inf, "R_inf_over_R0": R_inf / R0, "H_inf_over_R0": dep["H_inf"] / R0,
         "H_inf_over_H0": dep["H_inf"] / H0, "H_wall0": H_wall0, "H_inf_over_H_wall0": dep["H_inf"] / H_wall0, "H_inf_over_D": dep["H_inf"] / D, "deposit_time": ts, **dep, **stop,
         "Re_p_max": rep[irep][1] if rep else float("nan"), "t_Re_p_max": rep[irep][0] if rep else float("nan"),

@@ -245,7 +245,7 @@ void dem_neigh_gather(dem_t *d);
 /* The rank's share of the rows after a build. */
 void dem_neigh_partition(dem_t *d);
 
-/* ---- internal helpers (dem.c) ---- */
+/* ---- internal helpers (dem.c; dem_elastic_energy: dem_diag.c) ---- */
 void dem_grow(dem_t *d, int need);
 dem_status_t dem_set_dt(dem_t *d);
 /* Checks that need the particles (periodic lengths); sets the skin and image shifts. */
