@@ -20,7 +20,7 @@ import sys
 import h5py
 from paraview.simple import (Calculator, ColorBy, Contour, CreateView, GetColorTransferFunction, GetScalarBar, ResetCamera,
                              CellDatatoPointData,
-                             SaveScreenshot, Show, Slice, XDMFReader, servermanager)
+                             SaveScreenshot, Show, Slice, XDMFReader)
 
 run, png = sys.argv[1], sys.argv[2]
 with open(os.path.join(run, "column.json")) as f:
@@ -36,20 +36,23 @@ r.UpdatePipelineInformation()
 times = list(r.TimestepValues) or [0.0]
 t = min(times, key=lambda v: abs(v - t_want))
 r.UpdatePipeline(t)
-grid = servermanager.Fetch(r)
-arrays = {grid.GetCellData().GetArrayName(i) for i in range(grid.GetCellData().GetNumberOfArrays())}
+# what the reader gives, from its data information (the grid itself stays on the server)
+info = r.GetDataInformation()
+arrays = set(r.CellData.keys())
+ext = info.GetExtent()
+dims = (ext[1] - ext[0] + 1, ext[3] - ext[2] + 1, ext[5] - ext[4] + 1)
 need = {"pressure", "velocity", "solid_fraction"}
 if not need <= arrays:
     print(f"collapse_paraview: {run}: arrays {sorted(arrays)} lack {sorted(need - arrays)}")
     sys.exit(1)
-bounds = r.GetDataInformation().GetBounds()
-print(f"collapse_paraview: {grid.GetClassName()} {grid.GetDimensions()} points, {len(times)} snapshots; "
+bounds = info.GetBounds()
+print(f"collapse_paraview: {info.GetDataSetTypeAsString()} {dims} points, {len(times)} snapshots; "
       f"t = {t:.4f} s ({t / col['T_visq']:.0f} T_visq)")
 
 with h5py.File(os.path.join(run, "fields_00000.h5"), "r") as f:  # the grid the run wrote
     yf, shape = f["y"][...], f["pressure"].shape
-if shape != (grid.GetDimensions()[2] - 1, grid.GetDimensions()[1] - 1, grid.GetDimensions()[0] - 1):
-    print(f"collapse_paraview: {run}: ParaView's grid {grid.GetDimensions()} points, the HDF5 pressure {shape} cells")
+if shape != (dims[2] - 1, dims[1] - 1, dims[0] - 1):
+    print(f"collapse_paraview: {run}: ParaView's grid {dims} points, the HDF5 pressure {shape} cells")
     sys.exit(1)
 # the slice through the cell centre nearest to the middle of the width (not through a face)
 ymid = float(min(0.5 * (yf[1:] + yf[:-1]), key=lambda y: abs(y - 0.5 * (bounds[2] + bounds[3]))))
