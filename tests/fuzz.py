@@ -356,6 +356,7 @@ def main():
     ap.add_argument("--timeout", type=float, default=60, help="s per check (a run: twice this)")
     ap.add_argument("--memory", type=float, default=4, help="GB of address space per process (0: no limit)")
     ap.add_argument("--case", default="", help="only the case files whose path contains this")
+    ap.add_argument("--skip", action="append", default=[], help="leave out the case files whose path contains this")
     ap.add_argument("--only", default="", help="one mutant: check:M or run:M")
     ap.add_argument("--keep", action="store_true", help="keep the work folder")
     ap.add_argument("--work", default="")
@@ -373,7 +374,7 @@ def main():
     if sanitized:  # ASan needs its address space: cap its allocations instead
         env["ASAN_OPTIONS"] = env.get("ASAN_OPTIONS", "") + ":allocator_may_return_null=1:max_allocation_size_mb=%d" % (
             a.memory * 1024)
-    cases = sorted(c for c in glob.glob("cases/*/*.ini") if a.case in c)
+    cases = sorted(c for c in glob.glob("cases/*/*.ini") if a.case in c and not any(k in c for k in a.skip))
     print("# fuzz: seed %d, %d case files, %d check and %d run mutants each, work folder %s" % (
         a.seed, len(cases), a.checks, a.runs, work), flush=True)
 

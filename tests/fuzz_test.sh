@@ -8,8 +8,11 @@
 # must be reported.  TAP lines, one per case file and one for the harness.
 . "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_fuzz_test.XXXXXX)
+# Cases D and E of the column collapse are left out here: they have case A's keys (case.ini,
+# fuzzed here) on grids that cannot be shrunk (their periodic width is 22 cells, the least the
+# immersed band allows), so a run mutant costs 10-20 s; `make fuzz` covers them.
 $PY tests/fuzz.py --bin "$BIN" --seed "${FUZZ_SEED:-17}" --checks "${FUZZ_CHECKS:-1}" --runs "${FUZZ_RUNS:-1}" \
-    --jobs 4 >$T/fuzz.out 2>&1
+    --skip column_collapse/case_D.ini --skip column_collapse/case_E.ini --jobs 4 >$T/fuzz.out 2>&1
 rc=$?
 grep -v '^1\.\.' $T/fuzz.out
 n=$(grep -c '^\(not \)\?ok ' $T/fuzz.out)

@@ -40,18 +40,26 @@ rollback() { # name N args... (NP ranks)
     local rc=$?
     local ck=$d/$(printf "checkpoint_%08d.h5" $((N - 1)))
     grep -q "the run diverged at step $N " $d.log && rc=3 # (mpirun's status is its own)
+    echo "# $name: exit $rc at the divergence"
     [ $rc = 3 ] && [ -e $ck ] && grep -q "the state at the start of that step (step $((N - 1))" $d.log &&
         $run "$@" $OUT --set time.max_steps=$E --out $d --restart $ck >>$d.log 2>&1 &&
         $run "$@" $OUT --set time.max_steps=$E --out $d.straight >$d.straight.log 2>&1 &&
         $PY tests/compare_runs.py $d $d.straight
-    report $? "$name: diverged at step $N (exit $rc), the state of step $((N - 1)) kept; restarted from it, the folder is the uninterrupted run's"
 }
-rollback fluid 15 $CAV
-rollback ibm 8 $SET
-rollback dem 25 $DEM
+said() { echo "$1: diverged at step $2 (status 3), the state of step $(($2 - 1)) kept; restarted from it, the folder is the uninterrupted run's"; }
+# the one-rank cases two at a time
+side_start fluid rollback fluid 15 $CAV
+side_start ibm rollback ibm 8 $SET
+side_report fluid "$(said fluid 15)"
+side_report ibm "$(said ibm 8)"
+side_start dem rollback dem 25 $DEM
+side_start coupled rollback coupled 30 $BNC
+side_report dem "$(said dem 25)"
+side_report coupled "$(said coupled 30)"
 NP=2 rollback dem_np2 25 $DEM
-rollback coupled 30 $BNC
+report $? "$(said dem_np2 25)"
 rollback porenet 89 $PNT
+report $? "$(said porenet 89)"
 
 # 2. a coupled run that diverges: the DEM's overlap limit at the first contact
 R="$BNC --set particles.particle1=center,0,0.7,0,diameter,1,density,8 --set dem.max_overlap=1e-6 --set lubrication.model=none"

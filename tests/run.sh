@@ -7,6 +7,10 @@ BUILD=${BUILD:-build}
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1
 # ranks may share cores with other jobs: yield instead of busy-polling
 export OMPI_MCA_mpi_yield_when_idle=1
+# start-up: a run started without mpirun stays a singleton (no daemon), and the ranks talk
+# through the ob1 layer (shared memory) instead of initialising UCX: 0.3 s against 0.9 s for
+# a singleton's MPI_Init, 0.9 s against 1.2 s for mpirun -np 2 (the suite starts hundreds of runs)
+export OMPI_MCA_ess_singleton_isolated=1 OMPI_MCA_pml=ob1
 export BUILD
 MPIRUN="mpirun --allow-run-as-root --oversubscribe"
 if [ "$BUILD" = build-san ]; then
@@ -43,6 +47,7 @@ for sh in tests/*_test.sh; do
     name=$(basename "$sh" .sh)
     [ -n "$filter" ] && [[ ! "$name" =~ $filter ]] && continue
     echo "=== $name"
+    t0=$(date +%s.%N)
     if timeout 900 bash "$sh" >"$log" 2>&1; then
         cat "$log"; p=$(grep -c '^ok ' "$log"); f=$(grep -c '^not ok ' "$log")
     else
@@ -50,6 +55,7 @@ for sh in tests/*_test.sh; do
     fi
     pass=$((pass + p)); fail=$((fail + f))
     [ "$f" != 0 ] && failed_names="$failed_names $name"
+    awk -v a="$t0" -v b="$(date +%s.%N)" -v n="$name" 'BEGIN{printf "=== %s: %.1f s\n", n, b-a}'
 done
 rm -f "$log"
 [ -n "$failed_names" ] && echo "failed:$failed_names"
