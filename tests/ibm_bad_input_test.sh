@@ -20,6 +20,10 @@ check density "${base3d}sphere1 = free center 0.5 0.5 0.5 radius 0.1\n" "ibm.sph
 check number "${base3d}sphere1 = fixed center 0.5 x 0.5 radius 0.1\n" "ibm.sphere1: center: 'x' is not a number"
 check noradius "${base3d}sphere1 = fixed center 0.5 0.5 0.5\n" "ibm.sphere1: no radius"
 check period "${base3d}sphere1 = fixed center 0.5 0.5 0.5 radius 0.4\n" "ibm.sphere1: sphere 1 \(radius 0.4\) and its band"
+# cells longer in x than in y and z: the band is counted in the largest spacing at the sphere, so the sphere
+# fits x (walls) but its band does not fit the periodic y (a run stopped with status 1 at the first step before)
+flat='[domain]\nnx = 4\nny = 32\nnz = 32\nlength = 1 1 1\n[boundary]\nx_lo = noslip\nx_hi = noslip\n[fluid]\nnu = 1\n[time]\nt_end = 1\n[ibm]\n'
+check flatcells "${flat}sphere1 = fixed center 0.5 0.5 0.5 radius 0.1\n" "ibm.sphere1: sphere 1 \(radius 0.1\) and its band of [0-9.]+ cells of 0.25 do not fit in the periodic y length 1"
 check axis "${axi}sphere1 = free center 0.2 0.5 0 radius 0.1 density 2\n" "ibm.sphere1: an axisymmetric sphere must be on the axis"
 check swirl "${axi}sphere1 = prescribed center 0 0.5 0 radius 0.1 omega 0 1 0\n" "ibm.sphere1: an axisymmetric sphere cannot rotate"
 check rigid1 "${base3d}force_model = rigid\nsphere1 = free center 0.5 0.5 0.5 radius 0.1 density 1\n" "ibm.force_model: rigid divides by"

@@ -100,7 +100,7 @@ static inline int wrap(int i, int n)
 }
 
 /* First global index whose node coordinate is >= x (non-periodic x). */
-static int lower_index(const grid_t *g, int c, double x)
+int ibm_lower_index(const grid_t *g, int c, double x)
 {
     const double *a = c == 0 ? g->gxf : g->gxc;
     int lo = 0, hi = n_unknowns(g, c, 0); /* answer in [lo, hi] */
@@ -120,8 +120,8 @@ static int lower_index(const grid_t *g, int c, double x)
 static int index_range(const grid_t *g, int d, int c, double a, double b, int *lo, int *hi)
 {
     if (d == 0 && !g->periodic[0]) {
-        *lo = lower_index(g, c, a);
-        *hi = lower_index(g, c, b) - 1;
+        *lo = ibm_lower_index(g, c, a);
+        *hi = ibm_lower_index(g, c, b) - 1;
         int nu = n_unknowns(g, c, 0);
         if (*hi >= nu) *hi = nu - 1;
     } else {
@@ -147,7 +147,7 @@ static int sphere_box(const ibm_t *ibm, const ibm_sphere_t *s, int c, int lo[3],
     if (g->dim == 3) hmax = fmax(hmax, g->dz);
     /* x spacing near the sphere, then over the whole x range of the box
      * (stretched grids: the margin must cover the largest cell in it) */
-    int ic = lower_index(g, -1, s->xa[0]);
+    int ic = ibm_lower_index(g, -1, s->xa[0]);
     if (ic >= g->n[0]) ic = g->n[0] - 1;
     if (g->periodic[0]) ic = 0;
     hmax = fmax(hmax, g->gdxf[ic]);

@@ -553,12 +553,17 @@ static void check_spheres(cfg_t *cfg, const grid_t *g, const ibm_sphere_t *s, in
     static const char *face[3][2] = {{"x_lo", "x_hi"}, {"y_lo", "y_hi"}, {"z_lo", "z_hi"}};
     for (int p = 0; p < n; p++) {
         const double R = s[p].radius;
+        /* the band's width is counted in the largest cell spacing at the sphere (alpha.c's
+         * sphere_box), whatever the direction */
+        int ic = g->periodic[0] ? 0 : ibm_lower_index(g, -1, s[p].x[0]);
+        if (ic >= g->n[0]) ic = g->n[0] - 1;
+        const double hmax = fmax(fmax(g->gdxf[ic], g->dy), g->dim == 3 ? g->dz : 0.0);
         for (int d = 0; d < g->dim; d++) {
-            const double h = d == 0 ? g->gdxf[0] : d == 1 ? g->dy : g->dz;
+            const double h = d == 0 ? g->gdxf[ic] : d == 1 ? g->dy : g->dz;
             /* along a periodic direction a sphere and its band must fit in the period */
-            if (g->periodic[d] && 2 * (R + (band + 0.5) * h) + h > g->L[d])
-                SPHERE_FAIL(p, "sphere %d (radius %g) and its band of %.2f cells do not fit in the periodic %c length %g: "
-                            "enlarge the domain", p + 1, R, band, "xyz"[d], g->L[d]);
+            if (g->periodic[d] && 2 * (R + (band + 0.5) * hmax) + h > g->L[d])
+                SPHERE_FAIL(p, "sphere %d (radius %g) and its band of %.2f cells of %g do not fit in the periodic %c "
+                            "length %g: enlarge the domain", p + 1, R, band, hmax, "xyz"[d], g->L[d]);
             if (g->periodic[d]) continue;
             const int radial = g->geom == GEOM_AXI && d == 0; /* on the axis: its radius against the radial extent */
             if ((radial ? R : 2 * R) >= g->L[d])

@@ -94,6 +94,9 @@ typedef struct {
 static inline ibm_priv_t *ibm_priv(const ibm_t *ibm) { return (ibm_priv_t *)ibm->priv; }
 
 /* alpha.c */
+/* First global index whose node coordinate is >= x along a non-periodic x
+ * (c: component, -1 for cell centres). */
+int ibm_lower_index(const grid_t *g, int c, double x);
 /* The node lists at the current centres xa, with, in the same pass, the
  * targets of the forcing (targets != 0) and the momentum integrals into
  * mom (not NULL; see ibm_sums_of). */
