@@ -4,6 +4,7 @@
 # summary.json), and a restart from a checkpoint that continues the run bit for bit
 # (on 1 and 2 ranks: the checkpoint holds the particles in their current order and
 # the neighbour lists, so the force sums are taken in the same order).
+# Also: a LAMMPS data file as the particles of a run, and a bad line of it refused as bad input.
 source "$(dirname "$0")/tap.sh"
 tmp=$(mktemp -d /tmp/ibmdem_dem_driver.XXXXXX)
 case=cases/dem_inclined_plane/coarse.ini
@@ -47,4 +48,44 @@ sys.exit(0 if abs(ta - tb) < 1e-12 and (ia == ib).all() and dx == 0 else 1)
 EOF
     report $? "the restarted run ends exactly where the uninterrupted one does ($np rank(s))"
 done
+# a LAMMPS data file (atom_style sphere: id type diameter density x y z; Velocities: id vx vy vz wx wy wz),
+# read as the particles of a run (src/dem/dem_lammps.c); a bad line is bad input of particles.file
+cat >$tmp/two.data <<'EOF'
+two spheres
+
+2 atoms
+1 atom types
+0 0.04 xlo xhi
+0 0.025 ylo yhi
+0 0.15 zlo zhi
+
+Atoms
+
+1 1 0.004 2500 0.01 0.0125 0.05
+2 1 0.0048 2000 0.03 0.0125 0.05
+
+Velocities
+
+1 1.5 0 0 0 0 3
+2 -0.5 0 0 0 0 0
+EOF
+lm="--set particles.source=lammps_data --set particles.file=$tmp/two.data --set bed.type=none --set packing.prepare=false
+    --set dem.gravity=0,0,0 --set time.t_end=0.001 --set output.fields_every=0"
+$BIN run $case $lm --out $tmp/lmp > $tmp/lmp.log 2>&1 &&
+$PY - $tmp/lmp <<'EOF'
+import sys, h5py, glob, numpy as np
+with h5py.File(sorted(glob.glob(sys.argv[1] + "/checkpoint_*.h5"))[-1], "r") as h:
+    names = []
+    h.visit(names.append)
+    r = np.sort(np.asarray(h[[n for n in names if n.endswith("radius")][0]]))
+    print("# radii", r)
+sys.exit(0 if r.shape == (2,) and np.allclose(r, [0.002, 0.0024]) else 1)
+EOF
+report $? "a LAMMPS data file gives the run its particles (2, radii 0.002 and 0.0024 m)"
+sed 's/^2 1 0.0048 2000 0.03 0.0125 0.05$/2 1 0.0048 2000 0.03 x 0.05/' $tmp/two.data >$tmp/bad.data
+out=$($BIN check $case --set particles.source=lammps_data --set particles.file=$tmp/bad.data --set bed.type=none \
+    --set packing.prepare=false 2>&1); rc=$?
+echo "$out" | grep -q "particles.file: $tmp/bad.data:12: a Atoms line needs 7" && [ $rc = 2 ]
+report $? "a LAMMPS data line with a word for a number is bad input (status $rc): $(echo "$out" | tail -1 | cut -c1-90)"
+
 tap_end $tmp
