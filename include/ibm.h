@@ -182,10 +182,10 @@ double ibm_alpha(double d, const double n[3], double h);
 double ibm_calibrated_retraction(double kappa, double h_over_R);
 
 /* `radius_correction = gaps`: the uniform part of the retraction (cells),
- * r(κ) − 0.097 h/R, and the local thickening (length) of a sphere's forced
+ * r(κ) − 0.084 h/R, and the local thickening (length) of a sphere's forced
  * radius at a node whose distance to the nearest other sphere's surface is G
  * (clamped to [0, IBM_GAP_CUTOFF_D diameters]):
- *     min(0.42 h²/(G + 0.75 h), IBM_GAP_MAX h)
+ *     min(0.45 h²/(G + h), IBM_GAP_MAX h)
  * (docs/theory.md §6b). */
 #define IBM_GAP_MAX 0.4
 #define IBM_GAP_CUTOFF_D 2.0

@@ -52,8 +52,8 @@ static const cfg_key_t ibm_keys[] = {
     {"ibm", "radius_correction", CFG_ENUM, "none", 1, 0, "none|calibrated|gaps",
      "calibrated: the solid fraction is moreover that of the radius R - (r(κ) - 0.282 Δx/R) Δx, the hydrodynamic "
      "thickening of the band measured on Stokes flow through sphere arrays (needs forcing_time in [0.1, 0.3] and "
-     "forcing_iterations = 0; see docs/theory.md); gaps (3-D): the radius R - (r(κ) - 0.097 Δx/R) Δx + "
-     "min(0.42 Δx²/(G + 0.75 Δx), 0.4 Δx) at each node, G its distance to the nearest other sphere's surface "
+     "forcing_iterations = 0; see docs/theory.md); gaps (3-D): the radius R - (r(κ) - 0.084 Δx/R) Δx + "
+     "min(0.45 Δx²/(G + Δx), 0.4 Δx) at each node, G its distance to the nearest other sphere's surface "
      "(at most 2 diameters): also corrects the narrow gaps of dense arrays and beds (same conditions; the "
      "neighbour search costs O(N²) per rebuild of the solid fraction); none: the seed's volume fraction"},
     {"ibm", "spheres_file", CFG_STRING, NULL, 1, 0, NULL,
@@ -99,18 +99,18 @@ static double retraction_fit(double kappa, double h_over_R, double d)
 double ibm_calibrated_retraction(double kappa, double h_over_R) { return retraction_fit(kappa, h_over_R, 0.282); }
 
 /* `radius_correction = gaps`: the same r(κ), and a second-order part split
- * into −0.097 h/R and the local term 0.42 h²/(G + 0.75 h) of each node
+ * into −0.084 h/R and the local term 0.45 h²/(G + h) of each node
  * (G its distance to the nearest other sphere's surface), fitted on Stokes
- * flow through the simple cubic arrays c = 0.064 (which sets the 0.097, the
+ * flow through the simple cubic arrays c = 0.064 (which sets the 0.084, the
  * gap term being part of the 0.282 of `calibrated` there), 0.216 and 0.343
  * at D/Δx ≈ 8 and 12 with κ = 0.2 (docs/theory.md §6b): the drag of a narrow
  * gap is underestimated by a smoothed band, as by a sphere smaller by about
  * 0.17 h²/g (g the gap), which a radius fitted on a dilute array leaves. */
-double ibm_gap_retraction(double kappa, double h_over_R) { return retraction_fit(kappa, h_over_R, 0.097); }
+double ibm_gap_retraction(double kappa, double h_over_R) { return retraction_fit(kappa, h_over_R, 0.084); }
 
 double ibm_gap_thickening(double G, double h)
 {
-    double e = 0.42 * h * h / (G + 0.75 * h);
+    double e = 0.45 * h * h / (G + h);
     return e < IBM_GAP_MAX * h ? e : IBM_GAP_MAX * h;
 }
 
