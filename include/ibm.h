@@ -88,7 +88,9 @@ typedef struct {
     int forcing_iterations; /* extra force + project passes per stage (0: one forcing) */
     double gravity[3];    /* acts on the particles only (pressure relative to hydrostatic) */
     double retraction;    /* α is taken for the radius R − retraction × h (h the cell size) */
-    int radius_calibrated; /* 1: and less the calibrated thickening of the band, ibm_calibrated_retraction() */
+    int radius_calibrated; /* IBM_RADIUS_*: 1 (calibrated): less the calibrated thickening of the band,
+                            * ibm_calibrated_retraction(); 2 (gaps): the same fit with the local gap term,
+                            * ibm_gap_retraction() and ibm_gap_thickening() */
     double forcing_time;  /* κ: partially covered nodes relax towards U with the time scale
                            * τ = κ h²/ν (0: the seed's u ← u + α (U − u) at every stage) */
     int free_alpha_per_step; /* 1: a free sphere's α is held over the fluid step and moved
@@ -179,8 +181,22 @@ double ibm_alpha(double d, const double n[3], double h);
  * for forcing_time κ ∈ [0.1, 0.3] (docs/theory.md §6b). */
 double ibm_calibrated_retraction(double kappa, double h_over_R);
 
+/* `radius_correction = gaps`: the uniform part of the retraction (cells),
+ * r(κ) − 0.084 h/R, and the local thickening (length) of a sphere's forced
+ * radius at a node whose distance to the nearest other sphere's surface is G
+ * (clamped to [0, IBM_GAP_CUTOFF_D diameters]):
+ *     min(0.45 h²/(G + h), IBM_GAP_MAX h)
+ * (docs/theory.md §6b). */
+#define IBM_GAP_MAX 0.4
+#define IBM_GAP_CUTOFF_D 2.0
+enum { IBM_RADIUS_NONE = 0, IBM_RADIUS_CALIBRATED = 1, IBM_RADIUS_GAPS = 2 };
+double ibm_gap_retraction(double kappa, double h_over_R);
+double ibm_gap_thickening(double G, double h);
+
 /* The radius whose smoothed indicator is forced for a sphere of radius R at
- * cell size h: R − retraction h, less the calibrated retraction if chosen. */
+ * cell size h: R − retraction h, less the calibrated retraction if chosen
+ * (with `gaps`, the uniform part; the local thickening is added node by
+ * node, alpha.c). */
 double ibm_forced_radius(const ibm_t *ibm, double R, double h);
 /* Half-width of the band where 0 < α < 1, in units of h. */
 double ibm_band_halfwidth(void);

@@ -489,7 +489,7 @@ def finite_re_reference(name, cs, allruns):
 
 def summary_lines(table):
     """one row per case and D/dx: K, error and CPU seconds of each code side by side"""
-    keys = ["OpenFOAM/snappy", "ibmdem/calibrated", "ibmdem/none"]
+    keys = ["OpenFOAM/snappy", "ibmdem/calibrated", "ibmdem/none", "ibmdem/gaps"]
     out = ["## Summary: K, K/K_ref - 1, CPU seconds (one core)", "",
            "| case | K_ref | D/dx | " + " | ".join(keys) + " |", "|---|---|---|" + "---|" * len(keys)]
     for name, t in table.items():
@@ -603,7 +603,7 @@ def main():
     a.add_argument("out")
     a.add_argument("--code", choices=["ibm", "foam", "both"], default="both")
     a.add_argument("--levels", default=None, help="indices into the case's series, e.g. 0,1,2")
-    a.add_argument("--methods", default="calibrated", help="ibmdem radius_correction values, e.g. none,calibrated")
+    a.add_argument("--methods", default="calibrated", help="ibmdem radius_correction values, e.g. none,calibrated,gaps")
     b = sub.add_parser("report")
     b.add_argument("out")
     args = ap.parse_args()

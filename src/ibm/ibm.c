@@ -49,10 +49,13 @@ static const cfg_key_t ibm_keys[] = {
     {"ibm", "retraction", CFG_DOUBLE, "0", -1, 1, NULL,
      "the solid fraction is that of a sphere of radius R - retraction × Δx (cells): compensates the effective "
      "thickening of the forced sphere (0: the seed's method)"},
-    {"ibm", "radius_correction", CFG_ENUM, "none", 1, 0, "none|calibrated",
+    {"ibm", "radius_correction", CFG_ENUM, "none", 1, 0, "none|calibrated|gaps",
      "calibrated: the solid fraction is moreover that of the radius R - (r(κ) - 0.282 Δx/R) Δx, the hydrodynamic "
      "thickening of the band measured on Stokes flow through sphere arrays (needs forcing_time in [0.1, 0.3] and "
-     "forcing_iterations = 0; see docs/theory.md); none: the seed's volume fraction"},
+     "forcing_iterations = 0; see docs/theory.md); gaps (3-D): the radius R - (r(κ) - 0.084 Δx/R) Δx + "
+     "min(0.45 Δx²/(G + Δx), 0.4 Δx) at each node, G its distance to the nearest other sphere's surface "
+     "(at most 2 diameters): also corrects the narrow gaps of dense arrays and beds (same conditions; the "
+     "neighbour search costs O(N²) per rebuild of the solid fraction); none: the seed's volume fraction"},
     {"ibm", "spheres_file", CFG_STRING, NULL, 1, 0, NULL,
      "many spheres: a CSV file (header with x,y,z,radius or diameter; optional density,u,v,w,ox,oy,oz,kind or "
      "fixed) or an HDF5 packing (.h5: datasets position [n][3], radius; optional density, velocity, omega, fixed)", CFG_CONDITIONAL},
@@ -83,20 +86,40 @@ ibm_params_t ibm_default_params(void)
  * runs at D/Δx = 11.9 and 15.9, interpolated linearly.  Below D/Δx = 4
  * (h/R > 0.5, far outside the calibration) the term of D/Δx = 4 is kept, so
  * that the forced band stays within the margin of sphere_box(). */
-double ibm_calibrated_retraction(double kappa, double h_over_R)
+static double retraction_fit(double kappa, double h_over_R, double d)
 {
     if (h_over_R > 0.5) h_over_R = 0.5;
     static const double r_of_kappa[5] = {0.3135, 0.1903, 0.1027, 0.0335, -0.0229};
     double x = (kappa - 0.1) / 0.05;
     int i = x < 0 ? 0 : (x >= 4 ? 3 : (int)x);
     double w = x - i;
-    return (1 - w) * r_of_kappa[i] + w * r_of_kappa[i + 1] - 0.282 * h_over_R;
+    return (1 - w) * r_of_kappa[i] + w * r_of_kappa[i + 1] - d * h_over_R;
+}
+
+double ibm_calibrated_retraction(double kappa, double h_over_R) { return retraction_fit(kappa, h_over_R, 0.282); }
+
+/* `radius_correction = gaps`: the same r(κ), and a second-order part split
+ * into −0.084 h/R and the local term 0.45 h²/(G + h) of each node
+ * (G its distance to the nearest other sphere's surface), fitted on Stokes
+ * flow through the simple cubic arrays c = 0.064 (which sets the 0.084, the
+ * gap term being part of the 0.282 of `calibrated` there), 0.216 and 0.343
+ * at D/Δx ≈ 8 and 12 with κ = 0.2 (docs/theory.md §6b): the drag of a narrow
+ * gap is underestimated by a smoothed band, as by a sphere smaller by about
+ * 0.17 h²/g (g the gap), which a radius fitted on a dilute array leaves. */
+double ibm_gap_retraction(double kappa, double h_over_R) { return retraction_fit(kappa, h_over_R, 0.084); }
+
+double ibm_gap_thickening(double G, double h)
+{
+    double e = 0.45 * h * h / (G + h);
+    return e < IBM_GAP_MAX * h ? e : IBM_GAP_MAX * h;
 }
 
 double ibm_forced_radius(const ibm_t *ibm, double R, double h)
 {
     double r = ibm->prm.retraction;
-    if (ibm->prm.radius_calibrated) r += ibm_calibrated_retraction(ibm->prm.forcing_time, h / R);
+    const double kappa = ibm->prm.forcing_time;
+    if (ibm->prm.radius_calibrated == IBM_RADIUS_CALIBRATED) r += ibm_calibrated_retraction(kappa, h / R);
+    if (ibm->prm.radius_calibrated == IBM_RADIUS_GAPS) r += ibm_gap_retraction(kappa, h / R);
     return R - r * h;
 }
 
@@ -298,6 +321,8 @@ void ibm_free(ibm_t *ibm)
     free(q->node_imp);
     free(q->line_head);
     free(q->entry_node);
+    free(q->nb_head);
+    free(q->nb);
     free(q->tmp);
     free(q->cnt);
     free(q->sum);
@@ -625,12 +650,16 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
     prm.retraction = cfg_double(cfg, "ibm", "retraction");
     prm.forcing_time = cfg_double(cfg, "ibm", "forcing_time");
     prm.radius_calibrated = cfg_enum(cfg, "ibm", "radius_correction");
+    const char *rc_name = prm.radius_calibrated == IBM_RADIUS_GAPS ? "gaps" : "calibrated";
     if (prm.radius_calibrated && !(prm.forcing_time >= 0.1 && prm.forcing_time <= 0.3))
         cfg_fail(cfg, "ibm", "radius_correction",
-                 "calibrated needs forcing_time in [0.1, 0.3] (the range of the calibration), not %g",
+                 "%s needs forcing_time in [0.1, 0.3] (the range of the calibration), not %g", rc_name,
                  prm.forcing_time);
     if (prm.radius_calibrated && prm.forcing_iterations > 0)
-        cfg_fail(cfg, "ibm", "radius_correction", "calibrated needs forcing_iterations = 0 (the calibrated forcing)");
+        cfg_fail(cfg, "ibm", "radius_correction", "%s needs forcing_iterations = 0 (the calibrated forcing)", rc_name);
+    if (prm.radius_calibrated == IBM_RADIUS_GAPS && g->dim != 3)
+        cfg_fail(cfg, "ibm", "radius_correction", "gaps is fitted on 3-D arrays of spheres: not in a 2-D or "
+                 "axisymmetric grid");
     prm.free_alpha_per_step = cfg_enum(cfg, "ibm", "free_alpha");
     prm.forcing_predictor = cfg_enum(cfg, "ibm", "cn_forcing") == 1;
     if (prm.forcing_predictor && prm.forcing_iterations > 0 && f->prm.implicit_viscous)

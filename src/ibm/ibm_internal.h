@@ -89,6 +89,14 @@ typedef struct {
     double t_stage0;   /* fluid time at the start of the step */
     int nhist;
     ibm_history_t *hist;
+    /* radius_correction = gaps: the neighbours of each sphere (the other
+     * spheres and the periodic images of all, itself included) whose surface
+     * may come within IBM_GAP_CUTOFF_D diameters of its band: nb[nb_head[p]
+     * .. nb_head[p + 1]), each the offset of the neighbour's centre from
+     * sphere p's and its radius (x, y, z, R); built with the node lists */
+    int32_t *nb_head;
+    double *nb;
+    long cap_nb;
 } ibm_priv_t;
 
 static inline ibm_priv_t *ibm_priv(const ibm_t *ibm) { return (ibm_priv_t *)ibm->priv; }
