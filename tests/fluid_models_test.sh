@@ -13,7 +13,7 @@
 #     falls at the closure's terminal velocity (Stokes, with the immersed weight) before the
 #     wall; coupling.fluid = none leaves the lubrication out ([lubrication] noted unused);
 #  5. [fluid] viscous = auto reports its choice in the log and summary.json.
-# Prints TAP lines; ~30 s.
+# Prints TAP lines; ~10 s.
 . "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_fluid_models.XXXXXX)
 Q="--set output.progress=off"

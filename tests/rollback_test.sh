@@ -46,7 +46,7 @@ rollback() { # name N args... (NP ranks)
         $run "$@" $OUT --set time.max_steps=$E --out $d.straight >$d.straight.log 2>&1 &&
         $PY tests/compare_runs.py $d $d.straight
 }
-said() { echo "$1: diverged at step $2 (status 3), the state of step $(($2 - 1)) kept; restarted from it, the folder is the uninterrupted run's"; }
+said() { echo "$1: diverged at step $2, the state of step $(($2 - 1)) kept; restarted from it, the folder is the uninterrupted run's"; }
 # the one-rank cases two at a time
 side_start fluid rollback fluid 15 $CAV
 side_start ibm rollback ibm 8 $SET

@@ -199,8 +199,7 @@ static void gap_neighbours(ibm_t *ibm)
     for (int i = 0; i < g->n[0]; i++) hmax = fmax(hmax, g->gdxf[i]);
     for (int p = 0; p < ibm->n; p++) rmax = fmax(rmax, ibm->s[p].radius);
     const double margin = (ibm_band_halfwidth() + IBM_GAP_MAX + 1.5) * hmax;
-    free(q->nb_head);
-    q->nb_head = xcalloc((size_t)ibm->n + 1, sizeof *q->nb_head);
+    if (!q->nb_head) q->nb_head = xcalloc((size_t)ibm->n + 1, sizeof *q->nb_head); /* ibm->n is fixed */
     long cnt = 0;
     for (int p = 0; p < ibm->n; p++) {
         const ibm_sphere_t *s = &ibm->s[p];
