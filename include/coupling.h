@@ -82,15 +82,28 @@ void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const 
  * drag responds to the velocity the particle gains within the step instead of
  * one step later.  The terms vanish when the velocity does not change (steady
  * states unchanged).  They are updated in chunks of DEM steps short against
- * the relaxation times m/c and I/c_r (at most 5 % of them). */
+ * the relaxation times m/c and I/c_r (at most 5 % of them).
+ * Hindered ([coupling] implicit_drag_hindrance = richardson_zaki): the force
+ * coefficient of each particle is c = 3πηD max(K, (1 − φ)^−4.65), φ its local
+ * solid fraction (dem_local_fraction, a ball of 1.5 mean diameters; at most 0.64) at the
+ * start of the fluid step: in a dense bed the resistance of a grain that
+ * moves against its neighbours is the hindered drag, tens of times the
+ * isolated sphere's. */
 typedef struct {
     int n;          /* spheres (0: off) */
     double k;       /* K */
     double mu;      /* dynamic viscosity η of the fluid */
     double *held;   /* 6n: the held force and torque of this step (by sphere) */
     long chunks;    /* DEM chunks done (statistics) */
+    int hindered;   /* implicit_drag_hindrance = richardson_zaki */
+    double *factor; /* by id: the force coefficient over 3πηD of this step */
+    double *phi;    /* by id: the local solid fraction (scratch) */
+    long nid;       /* length of factor and phi */
+    double phi_mean, factor_max; /* of the mobile particles, last step (diagnostics) */
 } coupling_drag_t;
-void coupling_drag_init(coupling_drag_t *dr, int n, double k, double mu);
+/* The hindered force coefficient over 3πηD: max(K, (1 − φ)^−n), n = 4.65, φ at most 0.64. */
+double coupling_drag_hindrance(double k, double phi);
+void coupling_drag_init(coupling_drag_t *dr, int n, double k, double mu, int hindered);
 void coupling_drag_free(coupling_drag_t *dr);
 /* Advance the DEM by dt after coupling_forces_to_dem (its external force and
  * torque are the held ones), the linear terms about the spheres' velocities

@@ -145,6 +145,19 @@ void dem_drag_register_keys(void);
 /* Local solid fraction φ of each particle and its drag force in the last
  * step (3 per particle), indexed by particle id (dem_ids); NULL without the
  * drag. */
+/* The local solid fraction of every particle, by id (phi_by_id[id]): the
+ * volume of the other spheres inside the ball of radius R about its centre
+ * (exact lens volumes; fixed ones included) over the ball's volume inside the
+ * box (caps beyond non-periodic faces removed) less its own; at most 0.95.
+ * ug_by_id (or NULL): 3 per id, the volume-weighted mean velocity of the
+ * other spheres in the ball (fixed ones at rest), fallback where it holds
+ * none.  A cell list: O(N).  (drag.c) */
+void dem_local_fraction(const dem_t *d, double R, double *phi_by_id, double *ug_by_id, const double fallback[3]);
+/* rel times the mean diameter of the mobile particles, reduced where the
+ * ball would not fit in half a periodic length (bit a of *clipped set). */
+double dem_fraction_radius(const dem_t *d, double rel, int *clipped);
+/* One more than the largest particle id (the size of arrays by id). */
+long dem_id_bound(const dem_t *d);
 const double *dem_drag_fraction(const dem_t *d);
 const double *dem_drag_forces(const dem_t *d);
 /* The grid spacing of the resolved fluid (model = correction adds only what it

@@ -25,11 +25,19 @@
  *    structure factor; measured below).
  *  - A restart from a checkpoint between two updates of the local fractions
  *    continues exactly (the held fractions are in the checkpoint).
+ *  - dem_local_fraction, shared with the coupling's hindered implicit drag:
+ *    three spheres of diameter 1 mm, B and C at 1.05 and 1.3 mm from A along
+ *    x and y (periodic box): A's fraction in a ball of radius 1.5 mm is the
+ *    two exact lens volumes over the ball less A's own volume; B's ball of
+ *    1.6 mm holds all of A (1.05 + 0.5 < 1.6) and part of C; a sphere
+ *    at 0.5 mm from a wall z_lo has the wall's cap taken from its ball; and
+ *    coupling_drag_hindrance is max(K, (1 − φ)^−4.65), φ capped at 0.64.
  */
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
+#include "coupling.h"
 #include "dem.h"
 #include "modules.h"
 #include "testutil.h"
@@ -258,6 +266,59 @@ static void test_restart(void **state)
     }
 }
 
+/* Volume of the intersection of balls of radii R and r whose centres are s
+ * apart (the lens; written out here, independent of drag.c's). */
+static double lens(double R, double r, double s)
+{
+    if (s >= R + r) return 0.0;
+    if (s <= fabs(R - r)) return 4.0 / 3.0 * M_PI * pow(fmin(R, r), 3);
+    const double d1 = (s * s - r * r + R * R) / (2 * s), d2 = s - d1; /* distances of the centres to the plane */
+    const double h1 = R - d1, h2 = r - d2;                              /* cap heights */
+    return M_PI * h1 * h1 * (3 * R - h1) / 3 + M_PI * h2 * h2 * (3 * r - h2) / 3;
+}
+
+static void test_local_fraction(void **state)
+{
+    (void)state;
+    const double r = 0.5e-3, V = 4.0 / 3.0 * M_PI * r * r * r;
+    dem_t *d = make("source = list\nparticle1 = center 0.005 0.005 0.005 radius 0.0005\n"
+                    "particle2 = center 0.00605 0.005 0.005 radius 0.0005\n"
+                    "particle3 = center 0.005 0.0063 0.005 radius 0.0005\n",
+                    "", PERIODIC);
+    double phi[3];
+    dem_local_fraction(d, 1.5e-3, phi, NULL, NULL);
+    const double ball15 = 4.0 / 3.0 * M_PI * pow(1.5e-3, 3);
+    const double exA = (lens(1.5e-3, r, 1.05e-3) + lens(1.5e-3, r, 1.3e-3)) / (ball15 - V);
+    const double sBC = sqrt(1.05e-3 * 1.05e-3 + 1.3e-3 * 1.3e-3);
+    const double exB = (lens(1.5e-3, r, 1.05e-3) + lens(1.5e-3, r, sBC)) / (ball15 - V);
+    printf("# local fraction, ball 1.5 mm: A %.6f (exact %.6f), B %.6f (exact %.6f)\n", phi[0], exA, phi[1], exB);
+    assert_true(fabs(phi[0] - exA) < 1e-12 && fabs(phi[1] - exB) < 1e-12);
+    dem_local_fraction(d, 1.6e-3, phi, NULL, NULL);
+    const double ball16 = 4.0 / 3.0 * M_PI * pow(1.6e-3, 3);
+    const double exB1 = (V + lens(1.6e-3, r, sBC)) / (ball16 - V); /* A whole inside B's ball */
+    assert_true(fabs(phi[1] - exB1) < 1e-12);
+    dem_free(d);
+    /* a wall: the ball's cap below z_lo is not fluid */
+    d = make("source = list\nparticle1 = center 0.005 0.005 0.0005 radius 0.0005\n"
+             "particle2 = center 0.005 0.0061 0.0005 radius 0.0005\n",
+             "", "[boundary]\nx_lo = periodic\nx_hi = periodic\ny_lo = periodic\ny_hi = periodic\nz_lo = noslip\n"
+             "z_hi = noslip\n");
+    dem_local_fraction(d, 1.5e-3, phi, NULL, NULL);
+    const double hcap = 1.5e-3 - 0.5e-3;
+    const double inbox = ball15 - M_PI * hcap * hcap * (3 * 1.5e-3 - hcap) / 3;
+    const double exW = lens(1.5e-3, r, 1.1e-3) / (inbox - V);
+    printf("# by a wall: %.6f (exact %.6f)\n", phi[0], exW);
+    assert_true(fabs(phi[0] - exW) < 1e-12);
+    dem_free(d);
+    /* the coefficient of the hindered implicit drag */
+    assert_true(coupling_drag_hindrance(4, 0.0) == 4.0);
+    assert_true(fabs(coupling_drag_hindrance(4, 0.6) - pow(0.4, -4.65)) < 1e-12 * pow(0.4, -4.65));
+    assert_true(fabs(coupling_drag_hindrance(1, 0.2) - pow(0.8, -4.65)) < 1e-15 * 10);
+    assert_true(coupling_drag_hindrance(4, 0.2) == 4.0); /* 0.8^-4.65 = 2.82 < K */
+    assert_true(coupling_drag_hindrance(4, 0.8) == coupling_drag_hindrance(4, 0.64)); /* capped at 0.64 */
+    assert_true(fabs(coupling_drag_hindrance(4, 0.64) - pow(0.36, -4.65)) < 1e-12 * pow(0.36, -4.65));
+}
+
 int main(int argc, char **argv)
 {
     test_mpi_init(&argc, &argv);
@@ -267,6 +328,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_hindered_settling),
         cmocka_unit_test(test_grains_frame),
         cmocka_unit_test(test_restart),
+        cmocka_unit_test(test_local_fraction),
     };
     TEST_MPI_RUN("dem_drag", tests);
 }

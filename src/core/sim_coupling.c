@@ -53,6 +53,11 @@ static const cfg_key_t coupling_keys[] = {
      "change since the fluid step, -K 3 pi eta D (U - U_n) and -K pi eta D^3 (omega - omega_n), so that a particle "
      "whose relaxation time is shorter than the fluid step is not driven by a stale force (docs/theory.md §9.1); "
      "0: the held force alone (the seed's)"},
+    {"coupling", "implicit_drag_hindrance", CFG_ENUM, "none", 1, 0, "none|richardson_zaki",
+     "implicit_drag > 0: the force coefficient K 3 pi eta D of every particle (none), or 3 pi eta D max(K, "
+     "(1 - phi)^-4.65), phi the particle's local solid fraction (a ball of 1.5 mean diameters; at most 0.64) at the start of "
+     "the fluid step (richardson_zaki: a grain in a dense bed moves against the hindered drag of its "
+     "neighbourhood, tens of times an isolated sphere's; docs/theory.md §9.1b)"},
     {"coupling", "restitution_axis", CFG_VEC3, NULL, -1e300, 1e300, NULL,
      "wall: direction from the particle towards the wall (default: along gravity)", CFG_OPTIONAL},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
@@ -416,6 +421,11 @@ static void part_summary(void *ctx, io_summary_t *y, const char *prefix)
         io_summary_double(y, KEY("numbers.tc_V_T_over_D"), q->tc_VT);
     }
     io_summary_double(y, KEY("dem_wall_seconds"), cp->wall_dem);
+    if (cp->drag.n && cp->drag.hindered) {
+        /* the last step's local solid fraction (mean over the mobile grains) and largest coefficient */
+        io_summary_double(y, KEY("implicit_drag_phi_mean"), cp->drag.phi_mean);
+        io_summary_double(y, KEY("implicit_drag_factor_max"), cp->drag.factor_max);
+    }
     const restitution_t *r = &cp->rest;
     if (r->mode != RESTITUTION_OFF) {
         const int wall = r->mode == RESTITUTION_WALL;
@@ -561,7 +571,7 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
     cp->stop_after = mode != RESTITUTION_OFF && cfg_bool(cfg, "coupling", "stop_after_rebound");
     if (ibm && ibm->n > 0 && cfg_double(cfg, "coupling", "implicit_drag") > 0)
         coupling_drag_init(&cp->drag, ibm->n, cfg_double(cfg, "coupling", "implicit_drag"),
-                           s->fluid->prm.rho * s->fluid->prm.nu);
+                           s->fluid->prm.rho * s->fluid->prm.nu, cfg_enum(cfg, "coupling", "implicit_drag_hindrance"));
     /* the lubrication correction adds what the grid does not resolve: it needs the grid spacing
      * (before the packing preparation, whose lists must hold every lubricated pair) */
     if (ibm) dem_lubrication_set_grid(sim_dem_engine_unprepared(s), grid_min_spacing(s->fluid->g));

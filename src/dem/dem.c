@@ -583,6 +583,7 @@ void dem_set_gravity(dem_t *d, const double g[3])
     for (int a = 0; a < 3; a++) d->gravity[a] = g[a];
 }
 int dem_count(const dem_t *d) { return d->n; }
+long dem_id_bound(const dem_t *d) { return d->next_id; }
 const double *dem_positions(const dem_t *d) { return d->x; }
 const double *dem_velocities(const dem_t *d) { return d->v; }
 const double *dem_omegas(const dem_t *d) { return d->w; }

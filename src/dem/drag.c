@@ -133,27 +133,12 @@ static double ball_in_box(const dem_t *d, const double c[3], double R)
     return v;
 }
 
-/* φ of every particle (by id), from a cell list of cell size ≥ R + r_max. */
-static void update_fraction(dem_t *d)
+void dem_local_fraction(const dem_t *d, double R, double *phi_by_id, double *ug_by_id, const double fallback[3])
 {
-    dem_drag_t *D = &d->drag;
     const int n = d->n;
-    if (!D->R) {
-        double dsum = 0;
-        int nm = 0;
-        for (int i = 0; i < n; i++)
-            if (!d->fixed[i]) dsum += 2 * d->r[i], nm++;
-        D->R = D->radius_rel * (nm ? dsum / nm : 2 * d->rmax);
-        for (int a = 0; a < 3; a++)
-            if (d->periodic[a] && D->R + d->rmax > 0.5 * d->L[a]) {
-                const double R = 0.5 * d->L[a] - d->rmax;
-                warn("dem: the drag's sampling ball (radius %g m) does not fit in half the periodic length along %c: "
-                     "radius %g m\n",
-                     D->R, 'x' + a, R);
-                D->R = R;
-            }
-    }
-    const double R = D->R, reach = R + d->rmax;
+    double rmax = 0; /* of the particles now (d->rmax is set by the first neighbour-list build) */
+    for (int i = 0; i < n; i++) rmax = fmax(rmax, d->r[i]);
+    const double reach = R + rmax;
     int nc[3];
     double cs[3];
     for (int a = 0; a < 3; a++) {
@@ -177,14 +162,6 @@ static void update_fraction(dem_t *d)
         /* c was built z-major: index (kz * ny + ky) * nx + kx */
         next[i] = head[c];
         head[c] = i;
-    }
-    if (D->nphi < d->next_id) {
-        D->phi = realloc(D->phi, (size_t)d->next_id * sizeof *D->phi);
-        D->fd = realloc(D->fd, 3 * (size_t)d->next_id * sizeof *D->fd);
-        memset(D->fd, 0, 3 * (size_t)d->next_id * sizeof *D->fd);
-        D->ug = realloc(D->ug, 3 * (size_t)d->next_id * sizeof *D->ug);
-        memset(D->ug, 0, 3 * (size_t)d->next_id * sizeof *D->ug);
-        D->nphi = d->next_id;
     }
     for (int i = 0; i < n; i++) {
         const double *xi = d->x + 3 * i;
@@ -224,12 +201,55 @@ static void update_fraction(dem_t *d)
                     }
         const double vol = ball_in_box(d, xi, R) - 4.0 / 3.0 * M_PI * d->r[i] * d->r[i] * d->r[i];
         double phi = vol > 0 ? vs / vol : 0.0;
-        D->phi[d->id[i]] = phi < 0.95 ? phi : 0.95;
-        for (int a = 0; a < 3; a++) D->ug[3 * d->id[i] + a] = vs > 0 ? vu[a] / vs : D->uf[a];
+        phi_by_id[d->id[i]] = phi < 0.95 ? phi : 0.95;
+        if (ug_by_id)
+            for (int a = 0; a < 3; a++) ug_by_id[3 * d->id[i] + a] = vs > 0 ? vu[a] / vs : fallback[a];
     }
     free(head);
     free(next);
     free(cell);
+}
+
+double dem_fraction_radius(const dem_t *d, double rel, int *clipped)
+{
+    double dsum = 0;
+    int nm = 0;
+    for (int i = 0; i < d->n; i++)
+        if (!d->fixed[i]) dsum += 2 * d->r[i], nm++;
+    double rmax = 0;
+    for (int i = 0; i < d->n; i++) rmax = fmax(rmax, d->r[i]);
+    double R = rel * (nm ? dsum / nm : 2 * rmax);
+    *clipped = 0;
+    for (int a = 0; a < 3; a++)
+        if (d->periodic[a] && R + rmax > 0.5 * d->L[a]) {
+            R = 0.5 * d->L[a] - rmax;
+            *clipped |= 1 << a;
+        }
+    return R;
+}
+
+/* φ of every particle (by id), in the drag's sampling ball. */
+static void update_fraction(dem_t *d)
+{
+    dem_drag_t *D = &d->drag;
+    if (!D->R) {
+        int clipped;
+        D->R = dem_fraction_radius(d, D->radius_rel, &clipped);
+        for (int a = 0; a < 3; a++)
+            if (clipped & (1 << a))
+                warn("dem: the drag's sampling ball (%g mean diameters) does not fit in half the periodic length "
+                     "along %c: radius %g m\n",
+                     D->radius_rel, 'x' + a, D->R);
+    }
+    if (D->nphi < d->next_id) {
+        D->phi = realloc(D->phi, (size_t)d->next_id * sizeof *D->phi);
+        D->fd = realloc(D->fd, 3 * (size_t)d->next_id * sizeof *D->fd);
+        memset(D->fd, 0, 3 * (size_t)d->next_id * sizeof *D->fd);
+        D->ug = realloc(D->ug, 3 * (size_t)d->next_id * sizeof *D->ug);
+        memset(D->ug, 0, 3 * (size_t)d->next_id * sizeof *D->ug);
+        D->nphi = d->next_id;
+    }
+    dem_local_fraction(d, D->R, D->phi, D->ug, D->uf);
     D->phi_step = d->step;
 }
 
