@@ -17,7 +17,9 @@
 #     IBMDEM_FAULT=diverge_retry@N: a divergence that the smaller step cures): the run goes on, logs
 #     the retry, counts it in summary.json (rejected_steps = 1), its step N is at most half the
 #     uninterrupted run's; restarted from a checkpoint after the retry, the folder is the faulted
-#     run's (resolved coupling: the bouncing sphere).
+#     run's (resolved coupling: the bouncing sphere);
+#  6. a retried step does not end a run with time.steady_tol as steady (the state restored at the
+#     start of the step compared with itself).
 # Prints TAP lines.
 . "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_rollback.XXXXXX)
@@ -112,5 +114,17 @@ cp -r $T/retry $T/retry_copy && rm -f $T/retry_copy/checkpoint_0000003[6-9].h5 $
     grep -q '"rejected_steps": 1,' $T/retry_copy/summary.json &&
     $PY tests/compare_runs.py $T/retry_copy $T/retry
 report $? "a diverging adaptive step (IBMDEM_FAULT=diverge_retry@$N, exit $rc) is taken again with half its dt, logged and counted; a restart after it gives the faulted run's folder"
+
+# 6. a retried step is not a steady state: the steady test compares the state with the one at the
+#    start of the step, and after a retry both are the restored state (a change rate of 0)
+$BIN run $CAV --set time.steady_tol=1e-12 --set time.max_steps=40 --set output.fields_every=0 --out $T/steady0 \
+    >$T/steady0.log 2>&1
+r0=$?
+IBMDEM_FAULT=diverge_retry@20 $BIN run $CAV --set time.steady_tol=1e-12 --set time.max_steps=40 \
+    --set output.fields_every=0 --out $T/steady1 >$T/steady1.log 2>&1
+r1=$?
+[ $r0 = 0 ] && [ $r1 = 0 ] && grep -q "step 20 (t = .*) diverged: .*taken again" $T/steady1.log &&
+    grep -q '"status": "max_steps",' $T/steady0/summary.json && grep -q '"status": "max_steps",' $T/steady1/summary.json
+report $? "a retried step does not end a run with steady_tol as steady (cavity, retry at step 20: max_steps 40 reached)"
 
 tap_end "$T"

@@ -199,7 +199,9 @@ static sim_status_t stop_condition(sim_t *s)
     for (int i = 0; i < s->npart; i++)
         if (s->part[i].done && s->part[i].done(s->part[i].ctx)) return SIM_DONE;
     if (s->prm.max_steps > 0 && s->step >= s->prm.max_steps) return SIM_MAX_STEPS;
-    if (s->prm.steady_tol > 0 && s->step > s->step0) {
+    /* (not after a retried step: the state is the one restored at the start of the failed
+     * step, which the change rate would compare with its own copy) */
+    if (s->prm.steady_tol > 0 && s->step > s->step0 && s->retries == 0) {
         double rate = 0.0;
         for (int i = 0; i < s->npart; i++)
             if (s->part[i].change_rate) rate = fmax(rate, s->part[i].change_rate(s->part[i].ctx, s->dt));
