@@ -1,14 +1,17 @@
 #!/usr/bin/env python3
 """Post-processing of immersed-avalanche runs ([avalanche], docs/theory.md §11).
 
-    avalanche.py RUN_DIR [RUN_DIR ...] [--out PREFIX] [--labels L1,L2,...] [--map]
+    avalanche.py RUN_DIR [RUN_DIR ...] [--out PREFIX] [--labels L1,L2,...] [--map] [--compare]
 
 A folder without summary.json (a run not finished) is left out with a note on stderr.
 
 For each run: the profiles of profiles.csv merged into slabs of one mean diameter (the thesis'
 averaging, eq. 4.8), the time series of Q_g, h_g and the compacity, and a row of the table
 (St, r, T in ms and in sqrt(D/g), T/T_v, T/T_i, T/T_ff, compacity, force shares, cost per part).
-Writes PREFIX.md (the table), PREFIX_profiles.png and PREFIX_series.png.
+Writes PREFIX.md (the table), PREFIX_profiles.png and PREFIX_series.png.  --compare adds, for
+every run against the last one listed (the largest box or the finest grid of a study), the ratio
+of the flow times and the relative L2 difference of the grains' velocity profiles (slabs of one D
+that both beds fill).
 """
 import argparse
 import csv
@@ -167,8 +170,7 @@ def profile_targets(runs, rows):
 
     def ug(k):
         if k not in prof:
-            p, D = read_profiles(os.path.join(runs[k], "profiles.csv"))
-            prof[k] = [(q["Ug"] / math.sqrt(9.81 * D), q["phi"]) for q in merge_diameter(p, D)]
+            prof[k] = grain_profile(runs[k])
         return prof[k]
 
     def both(a, b):  # the slabs of one D where both beds hold grains (phi >= 0.1)
@@ -197,12 +199,51 @@ def profile_targets(runs, rows):
     return out
 
 
+def grain_profile(run):
+    """The grains' velocity in slabs of one D, over sqrt(g D), with the slab's solid fraction."""
+    p, D = read_profiles(os.path.join(run, "profiles.csv"))
+    return [(q["Ug"] / math.sqrt(9.81 * D), q["phi"]) for q in merge_diameter(p, D)]
+
+
+def rel_l2(a, b):
+    """Relative L2 difference of profiles a and b (against b) over the slabs where both hold grains
+    (phi >= 0.1), of the profiles and of their shapes (each over its maximum there); returns both,
+    the two maxima and the number of slabs."""
+    n = min(len(a), len(b))
+    keep = [i for i in range(n) if a[i][1] >= 0.1 and b[i][1] >= 0.1]
+    if not keep:
+        return float("nan"), float("nan"), 0.0, 0.0, 0
+    ma, mb = max(a[i][0] for i in keep), max(b[i][0] for i in keep)
+
+    def l2(x, y):
+        den = sum(v ** 2 for v in y)
+        return math.sqrt(sum((u - v) ** 2 for u, v in zip(x, y)) / den) if den > 0 else float("nan")
+
+    x, y = [a[i][0] for i in keep], [b[i][0] for i in keep]
+    shape = l2([u / ma for u in x], [v / mb for v in y]) if ma > 0 and mb > 0 else float("nan")
+    return l2(x, y), shape, ma, mb, len(keep)
+
+
+def compare(runs, rows):
+    """Each run against the last one: T ratio and relative L2 of the grain velocity profile."""
+    ref, rr = grain_profile(runs[-1]), rows[-1]
+    out = []
+    for run, r in zip(runs[:-1], rows[:-1]):
+        d, shape, ma, mb, n = rel_l2(grain_profile(run), ref)
+        out.append("%s against %s: T %.4g against %.4g √(D/g) (ratio %.3f); over the %d slabs of one D both beds "
+                   "fill, relative L2 of ⟨U⟩_g %.3f, of its shape (over its maximum) %.3f, max ⟨U⟩_g/√(gD) %.3f "
+                   "against %.3f" % (r["run"], rr["run"], r["T_g"], rr["T_g"], r["T_g"] / rr["T_g"], n, d, shape, ma, mb))
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("runs", nargs="+")
     ap.add_argument("--out", default="avalanche")
     ap.add_argument("--labels", default=None)
     ap.add_argument("--map", action="store_true", help="also the regime map (St, r) with the thesis' lines")
+    ap.add_argument("--compare", action="store_true",
+                    help="each run against the last: flow time ratio, relative L2 of the grain velocity profile")
     a = ap.parse_args()
     runs = []
     for r in a.runs:
@@ -234,6 +275,8 @@ def main():
         text += "\nRuns that did not reach their end:\n\n" + "\n".join("- " + x for x in stopped) + "\n"
     text += "\n" + table42(rows)
     extra = profile_targets(a.runs, rows)
+    if a.compare and len(a.runs) > 1:
+        extra += compare(a.runs, rows)
     if extra:
         text += "\n" + "\n".join("- " + e for e in extra) + "\n"
     with open(a.out + ".md", "w") as f:
@@ -315,21 +358,26 @@ def main():
     ax[0].legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(a.out + "_profiles.png", dpi=120)
-    fig, ax = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    fig, ax = plt.subplots(3, 1, figsize=(7, 8), sharex=True)
     for run, lab in zip(a.runs, labels):
         s = json.load(open(os.path.join(run, "summary.json")))["avalanche"]
         tg = s["sqrt_D_over_g"]
-        t, q, phi = [], [], []
+        t, q, u, phi = [], [], [], []
         with open(os.path.join(run, "series.csv")) as f:
             for r in csv.DictReader(f):
+                if not r["Q_g"]:  # a row still being written (a run in progress)
+                    continue
                 t.append(float(r["time"]) / tg)
                 q.append(float(r["Q_g"]))
+                u.append(float(r["U_g"]) / math.sqrt(9.81 * s["D"]))
                 phi.append(float(r["phi_bed"]))
         ax[0].plot(t, q, lw=0.7, label=lab)
-        ax[1].plot(t[1:], phi[1:], lw=0.7, label=lab)
+        ax[1].plot(t, u, lw=0.7, label=lab)
+        ax[2].plot(t[1:], phi[1:], lw=0.7, label=lab)
     ax[0].set_ylabel("Q_g (m³/s)")
-    ax[1].set_ylabel("φ (compacity)")
-    ax[1].set_xlabel("t / √(D/g)")
+    ax[1].set_ylabel("mean grain velocity U_g / √(gD)")
+    ax[2].set_ylabel("φ (compacity)")
+    ax[2].set_xlabel("t / √(D/g)")
     ax[0].legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(a.out + "_series.png", dpi=120)

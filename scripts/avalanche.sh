@@ -1,5 +1,5 @@
 #!/bin/bash
-# avalanche.sh OUT [map|table|production|all|post SET] — the immersed avalanche of Izard (2014) ch. 4
+# avalanche.sh OUT [map|table|production|all|domain|convergence|post SET] — the immersed avalanche of Izard (2014) ch. 4
 # (docs/validation.md "Immersed avalanche"; cases/avalanche/README.md).
 #   map         the regime map: rho_p/rho in {2.7, 4, 10, 40, 100} x St in {0.05, 0.3, 1, 4.5, 20, 100}
 #               (30 runs) and the seven cases of Table 4.3, in the quick box (coarse.ini: 3 D x 3 D,
@@ -8,6 +8,16 @@
 #   table       the seven cases of Table 4.3 alone, in the quick box as for map
 #   production  the seven cases of Table 4.3 in the production box (case.ini: 5 D x 5 D x 20 D,
 #               D/dx = 10, the thesis' contacts) to 300 sqrt(D/g), averaged from 200 sqrt(D/g)
+#   domain      target 7 (Table 4.1's box sizes): rho_p/rho = 4, Ar = 9 (St 0.153), L x W = 3 D, 5 D and 10 D
+#               (DOMAIN_BOXES, in D), H = 12 D, D/dx = 6, the thesis' contacts with t_c/dt = 20, beds of
+#               bed.ini's recipe scaled to the box (213 W^2/25 grains, hexagonal base; W = 5 reads bed.h5), to
+#               300 sqrt(D/g) averaged from 200 (DOMAIN_WINDOW="T_END AVG_FROM [WALL_LIMIT_S]"), one run at a time;
+#               OUT/domain/domain.md compares each box with the last (T, relative L2 of the grains' profile)
+#   convergence target 8: Table 4.3's cases 2 (viscous) and 3 (inertial) in the quick box (coarse.ini with the
+#               thesis' contacts) at D/dx in CONV_RES (default "5 8 10"), from a flowing bed (case 2 at D/dx 5
+#               from coarse_bed.h5 to 150 sqrt(D/g)), 60 sqrt(D/g) averaged from 30 (CONV_WINDOW="T_END AVG_FROM");
+#               one run at a time;
+#               OUT/convergence/case2.md and case3.md compare each resolution with the finest
 #   post SET    no run: post-processes the runs of OUT/SET (map, table or production) that finished
 #               (those with a summary.json), e.g. while the set runs or after it was stopped
 # Runs JOBS at a time (environment, default 2), in the order of the list: the seven cases of Table 4.3
@@ -16,7 +26,7 @@
 # then OUT/<set>.md (the table with regime labels by the thesis' method) and OUT/<set>_map.png,
 # OUT/<set>_profiles.png, OUT/<set>_series.png, from the runs that finished.
 set -u
-OUT=${1:?usage: avalanche.sh OUT [map|table|production|all|post SET]}
+OUT=${1:?usage: avalanche.sh OUT [map|table|production|all|domain|convergence|post SET]}
 WHAT=${2:-map}
 JOBS=${JOBS:-2}
 cd "$(dirname "$0")/.."
@@ -64,6 +74,53 @@ post() { # SET [RUN_DIR ...]: the table and figures of the runs that finished (a
     echo "avalanche.sh: $set: ${#done[@]} of $# runs finished" >&2
     $PY postproc/avalanche.py "${done[@]}" --out "$OUT/$set" --map
 }
+g() { $PY -c "print($1 * $TG)"; } # sqrt(D/g) -> s
+domain() {
+    local dirs=() w L n bed dir win=(${DOMAIN_WINDOW:-300 200 0})
+    mkdir -p "$OUT/domain"
+    for w in ${DOMAIN_BOXES:-3 5 10}; do
+        L=$($PY -c "print($w * 0.005)") bed=cases/avalanche/bed.h5 dir="$OUT/domain/W$w"
+        if [ "$w" != 5 ]; then # bed.ini's packing (213 grains in 5 D x 5 D) scaled to the box
+            bed="$OUT/domain/bed$w/bed.h5"
+            [ -f "$bed" ] || $BIN run cases/avalanche/bed.ini --set "domain.length=$L $L 0.15" \
+                --set particles.count=$($PY -c "print(round(213 * $w * $w / 25))") \
+                --set "particles.region_hi=$L $L 0.145" --set output.progress=off --set output.overwrite=true \
+                --out "$OUT/domain/bed$w" >"$OUT/domain/bed$w.log" 2>&1
+        fi
+        dirs+=("$dir")
+        [ -f "$dir/summary.json" ] && continue
+        n=$((6 * w))
+        $BIN run cases/avalanche/case.ini $($PY scripts/avalanche_set.py 4 0.153 2>/dev/null) \
+            --set particles.file="$bed" --set "domain.length=$L $L 0.06" --set domain.nx=$n --set domain.ny=$n \
+            --set domain.nz=72 --set dem.steps_per_contact=20 --set avalanche.flow_length=0.025 \
+            --set output.fields_every=0 --set output.checkpoint_every=1000 --set output.progress=off \
+            --set output.overwrite=true --set time.t_end=$(g ${win[0]}) --set avalanche.average_from=$(g ${win[1]}) \
+            --set time.wall_limit=${win[2]:-0} --out "$dir" >"$dir.log" 2>&1
+    done
+    $PY postproc/avalanche.py "${dirs[@]}" --compare --out "$OUT/domain/domain"
+}
+convergence() {
+    local c n dir dirs flow="$OUT/convergence/flowing" win=(${CONV_WINDOW:-60 30})
+    mkdir -p "$OUT/convergence"
+    if [ ! -f "$flow.h5" ]; then # the quick bed flowing: case 2 at D/dx 5 to 150 sqrt(D/g)
+        $BIN run cases/avalanche/coarse.ini $STIFF --set output.progress=off --set output.overwrite=true \
+            --set time.t_end=$(g 150) --set avalanche.average_from=$(g 100) --out "$flow" >"$flow.log" 2>&1
+        $PY scripts/checkpoint_particles.py "$(ls "$flow"/checkpoint_*.h5 | tail -1)" "$flow.h5"
+    fi
+    for c in 0.31 7.75; do
+        dirs=()
+        for n in ${CONV_RES:-5 8 10}; do
+            dir="$OUT/convergence/St${c}_res$n"
+            dirs+=("$dir")
+            [ -f "$dir/summary.json" ] && continue
+            $BIN run cases/avalanche/coarse.ini $STIFF $($PY scripts/avalanche_set.py 4 $c 2>/dev/null) \
+                --set particles.file="$flow.h5" --set domain.nx=$((3 * n)) --set domain.ny=$((3 * n)) \
+                --set domain.nz=$((12 * n)) --set output.progress=off --set output.overwrite=true \
+                --set time.t_end=$(g ${win[0]}) --set avalanche.average_from=$(g ${win[1]}) --out "$dir" >"$dir.log" 2>&1
+        done
+        $PY postproc/avalanche.py "${dirs[@]}" --compare --out "$OUT/convergence/case$([ $c = 0.31 ] && echo 2 || echo 3)"
+    done
+}
 case $WHAT in
 map | all)
     grid=${GRID:-}
@@ -75,6 +132,10 @@ table)
     run_set table cases/avalanche/coarse.ini 300 150 "$table43" "$STIFF" ;;
 production | all)
     run_set production cases/avalanche/case.ini 300 200 "$table43" ;;
+domain)
+    domain ;;
+convergence)
+    convergence ;;
 post)
     post "${3:?usage: avalanche.sh OUT post SET}" ;;
 esac
