@@ -19,7 +19,8 @@
 #     the last 20: T/T_v within the issue's band 0.7–1.5 (thesis 1.03–1.10; measured 1.40 here,
 #     1.34 over 150–300 sqrt(D/g) of the run that made the state);
 #  5. the bed's file does not move the case's walls (the DEM lid stays at the fluid's lid);
-#  6. the hindered implicit drag reads the flowing bed's local solid fraction.
+#  6. the hindered implicit drag reads the flowing bed's local solid fraction;
+#  7. postproc/avalanche.py --compare, exact on two profiles and a run against itself.
 # The triggering itself (~70 sqrt(D/g) in this box) is for make avalanche.  Prints TAP lines; ~50 s.
 . "$(dirname "$0")/tap.sh"
 T=$(mktemp -d /tmp/ibmdem_avalanche.XXXXXX)
@@ -103,5 +104,23 @@ print(f"# hindered implicit drag: mean local fraction {p:.4f}, largest coefficie
 sys.exit(not (0.35 <= p <= 0.65 and 20 <= f <= 116.5))
 PY
 report $? "the hindered implicit drag reads the flowing bed (mean local solid fraction, largest coefficient)"
+
+# 7. postproc/avalanche.py --compare (the domain and resolution studies): the relative L2 of two
+#    profiles over the slabs both beds fill (phi >= 0.1) and of their shapes: a profile twice another
+#    differs by 0.5 and has the same shape; a run compared with itself: T ratio 1, L2 0
+cp -r $T/flow $T/flow_copy # (one folder given twice is one run)
+$PY - <<'PY' && $PY postproc/avalanche.py $T/flow_copy $T/flow --compare --out $T/cmp >$T/cmp.log 2>&1 &&
+import importlib.util, sys
+spec = importlib.util.spec_from_file_location("av", "postproc/avalanche.py")
+av = importlib.util.module_from_spec(spec)
+spec.loader.exec_module(av)
+a = [(1.0, 0.5), (2.0, 0.4), (3.0, 0.05)]  # the third slab holds too few grains: left out
+b = [(2.0, 0.5), (4.0, 0.4), (9.0, 0.3)]
+d, shape, ma, mb, n = av.rel_l2(a, b)
+print("# rel_l2: %.12g %.3g %g %g %d" % (d, shape, ma, mb, n))
+sys.exit(not (abs(d - 0.5) < 1e-12 and abs(shape) < 1e-12 and (ma, mb, n) == (2.0, 4.0, 2)))
+PY
+    grep -q "(ratio 1.000); over the [0-9]* slabs of one D both beds fill, relative L2 of ⟨U⟩_g 0.000" $T/cmp.md
+report $? "avalanche.py --compare: relative L2 of profiles and shapes (exact on two profiles), a run against itself"
 
 tap_end $T
