@@ -22,6 +22,30 @@ def cpu_of(cmd, cwd, log, env=None, may_fail=False):
         sys.exit("crosscheck: %s failed (exit %d), see %s" % (" ".join(cmd), p.returncode, log))
     return (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime), time.time() - t0
 
+# The head of an ibmdem case file of the cross-check: a triply periodic cube of n^3 cells and side L,
+# the fluid of nu = rho = 1 with the explicit viscous term (the harness's steady settings).
+def periodic_cube_ini(n, L):
+    return """[domain]
+nx = %d
+ny = %d
+nz = %d
+length = %r %r %r
+
+[boundary]
+x_lo = periodic
+x_hi = periodic
+y_lo = periodic
+y_hi = periodic
+z_lo = periodic
+z_hi = periodic
+
+[fluid]
+nu = 1
+rho = 1
+viscous = explicit
+""" % (n, n, n, L, L, L)
+
+
 HEADER = """FoamFile
 {
     version 2.0;
