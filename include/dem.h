@@ -142,9 +142,6 @@ void dem_lubrication_register_keys(void);
 const double *dem_lubrication_forces(const dem_t *d);
 /* The drag closure of the fluid model drag (drag.c, [drag]). */
 void dem_drag_register_keys(void);
-/* Local solid fraction φ of each particle and its drag force in the last
- * step (3 per particle), indexed by particle id (dem_ids); NULL without the
- * drag. */
 /* The local solid fraction of every particle, by id (phi_by_id[id]): the
  * volume of the other spheres inside the ball of radius R about its centre
  * (exact lens volumes; fixed ones included) over the ball's volume inside the
@@ -158,6 +155,9 @@ void dem_local_fraction(const dem_t *d, double R, double *phi_by_id, double *ug_
 double dem_fraction_radius(const dem_t *d, double rel, int *clipped);
 /* One more than the largest particle id (the size of arrays by id). */
 long dem_id_bound(const dem_t *d);
+/* Local solid fraction φ of each particle and its drag force in the last
+ * step (3 per particle), indexed by particle id (dem_ids); NULL without the
+ * drag. */
 const double *dem_drag_fraction(const dem_t *d);
 const double *dem_drag_forces(const dem_t *d);
 /* The grid spacing of the resolved fluid (model = correction adds only what it
