@@ -88,14 +88,26 @@ void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const 
  * solid fraction (dem_local_fraction, a ball of 1.5 mean diameters; at most 0.64) at the
  * start of the fluid step: in a dense bed the resistance of a grain that
  * moves against its neighbours is the hindered drag, tens of times the
- * isolated sphere's. */
+ * isolated sphere's.  Relative (= relative): the hindered coefficient c_h acts
+ * on the particle's velocity change less the lens-volume-weighted mean change
+ * ΔŪ of the other spheres in the ball (fixed ones at rest), K on the rest:
+ *     F = −c_K ΔU − (c_h − c_K)(ΔU − ΔŪ),   ΔU = U − U_n,
+ * along the periodic directions, where a neighbourhood that accelerates
+ * together carries its pore fluid along (the bed's triggering); along a
+ * direction bounded by walls the volume flux of the mixture through a
+ * cross-section vanishes, a neighbourhood that moves together pushes the
+ * fluid through its pores, and the whole change meets c_h as with
+ * richardson_zaki (bounded[], coupling_drag_set_bounded). */
 typedef struct {
     int n;          /* spheres (0: off) */
     double k;       /* K */
     double mu;      /* dynamic viscosity η of the fluid */
     double *held;   /* 6n: the held force and torque of this step (by sphere) */
     long chunks;    /* DEM chunks done (statistics) */
-    int hindered;   /* implicit_drag_hindrance = richardson_zaki */
+    int hindered;   /* implicit_drag_hindrance: 0 none, 1 richardson_zaki, 2 relative */
+    dem_nbhood_t nbh; /* relative: the neighbourhoods of this step */
+    double *du;     /* relative: by id, 3 per particle, U − U_n at the start of a chunk (scratch) */
+    unsigned char bounded[3]; /* relative: the directions bounded by walls (not periodic); all by default */
     double *factor; /* by id: the force coefficient over 3πηD of this step */
     double *phi;    /* by id: the local solid fraction (scratch) */
     long nid;       /* length of factor and phi */
@@ -105,6 +117,8 @@ typedef struct {
 double coupling_drag_hindrance(double k, double phi);
 void coupling_drag_init(coupling_drag_t *dr, int n, double k, double mu, int hindered);
 void coupling_drag_free(coupling_drag_t *dr);
+/* relative: which directions are bounded (the fluid's non-periodic ones). */
+void coupling_drag_set_bounded(coupling_drag_t *dr, const int periodic[3]);
 /* Advance the DEM by dt after coupling_forces_to_dem (its external force and
  * torque are the held ones), the linear terms about the spheres' velocities
  * u, ω (the fluid step's) updated between chunks; am (or NULL): the

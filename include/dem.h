@@ -142,14 +142,28 @@ void dem_lubrication_register_keys(void);
 const double *dem_lubrication_forces(const dem_t *d);
 /* The drag closure of the fluid model drag (drag.c, [drag]). */
 void dem_drag_register_keys(void);
+/* The neighbourhoods dem_local_fraction read (its last argument, or NULL):
+ * the other spheres in the ball about the particle of id p are id[k], with
+ * weight w[k] (the lens volume of each inside the ball), for beg[p] <= k <
+ * end[p].  Arrays grown as needed; dem_nbhood_free releases them. */
+typedef struct dem_nbhood {
+    long *beg, *end; /* by id */
+    long *id;        /* the neighbours' ids */
+    double *w;       /* their lens volumes */
+    long nid, cap;   /* length of beg/end, of id/w */
+} dem_nbhood_t;
+void dem_nbhood_free(dem_nbhood_t *h);
 /* The local solid fraction of every particle, by id (phi_by_id[id]): the
  * volume of the other spheres inside the ball of radius R about its centre
  * (exact lens volumes; fixed ones included) over the ball's volume inside the
  * box (caps beyond non-periodic faces removed) less its own; at most 0.95.
  * ug_by_id (or NULL): 3 per id, the volume-weighted mean velocity of the
  * other spheres in the ball (fixed ones at rest), fallback where it holds
- * none.  A cell list: O(N).  (drag.c) */
-void dem_local_fraction(const dem_t *d, double R, double *phi_by_id, double *ug_by_id, const double fallback[3]);
+ * none.  nbh (or NULL): the neighbourhoods read.  A cell list: O(N).
+ * (drag.c) */
+void dem_local_fraction(const dem_t *d, double R, double *phi_by_id, double *ug_by_id, const double fallback[3],
+                        dem_nbhood_t *nbh);
+
 /* rel times the mean diameter of the mobile particles, reduced where the
  * ball would not fit in half a periodic length (bit a of *clipped set). */
 double dem_fraction_radius(const dem_t *d, double rel, int *clipped);

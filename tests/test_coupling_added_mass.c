@@ -29,6 +29,7 @@
 #include <string.h>
 
 #include "coupling.h"
+#include "couplingtest.h"
 #include "dem.h"
 #include "modules.h"
 #include "testutil.h"
@@ -45,24 +46,7 @@ static dem_t *make(double gz)
              "[lubrication]\nmodel = brenner\nroughness = 4e-4\nrange = 0.5\nviscosity = %g\n"
              "[dem]\ngravity = 0 0 %.17g\nsteps_per_contact = 50\n",
              TC, MU, gz);
-    cfg_t *cfg = cfg_load_string("test.ini", text, 0, NULL);
-    assert_non_null(cfg);
-    return dem_create_from_config(cfg, MPI_COMM_WORLD);
-}
-
-/* One sphere as the immersed boundary sees it (only its force and torque are read). */
-static ibm_t *fake_ibm(void)
-{
-    ibm_t *ibm = xcalloc(1, sizeof *ibm);
-    ibm->n = 1;
-    ibm->s = xcalloc(1, sizeof *ibm->s);
-    return ibm;
-}
-
-static void free_ibm(ibm_t *ibm)
-{
-    free(ibm->s);
-    free(ibm);
+    return test_dem_from_text(text);
 }
 
 static void test_held_force_acceleration(void **state)
@@ -72,7 +56,7 @@ static void test_held_force_acceleration(void **state)
     dem_t *d = make(g);
     const double x[3] = {0.05, 0.05, 0.05}, v[3] = {0, 0, 0};
     dem_add_particle(d, x, v, R, RHO_P, 0);
-    ibm_t *ibm = fake_ibm();
+    ibm_t *ibm = test_fake_ibm(1);
     ibm->s[0].force[2] = 3e-6; /* some drag */
     coupling_added_mass_t am;
     coupling_added_mass_init(&am, 1, CM);
@@ -90,7 +74,7 @@ static void test_held_force_acceleration(void **state)
     assert_true(fabs((dem_velocities(d)[2]) - (expect)) <= 1e-12 * fabs(expect));
     assert_true(fabs(am.dU[2]) < 1e-12 * fabs(expect));
     coupling_added_mass_free(&am);
-    free_ibm(ibm);
+    test_free_ibm(ibm);
     dem_free(d);
 }
 
@@ -102,7 +86,7 @@ static double throw_at_wall(int consistent, double dt, double u0, double *worst)
     dem_t *d = make(0.0);
     const double gap0 = 0.6 * R, x[3] = {0.05, 0.05, R + gap0}, v[3] = {0, 0, -u0};
     dem_add_particle(d, x, v, R, RHO_P, 0);
-    ibm_t *ibm = fake_ibm();
+    ibm_t *ibm = test_fake_ibm(1);
     coupling_added_mass_t am;
     coupling_added_mass_init(&am, 1, CM);
     if (consistent) coupling_added_mass_apply(&am, d, RHO_F);
@@ -129,7 +113,7 @@ static double throw_at_wall(int consistent, double dt, double u0, double *worst)
     }
     assert_true(touched);
     coupling_added_mass_free(&am);
-    free_ibm(ibm);
+    test_free_ibm(ibm);
     dem_free(d);
     return uR;
 }

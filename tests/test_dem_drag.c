@@ -286,14 +286,14 @@ static void test_local_fraction(void **state)
                     "particle3 = center 0.005 0.0063 0.005 radius 0.0005\n",
                     "", PERIODIC);
     double phi[3];
-    dem_local_fraction(d, 1.5e-3, phi, NULL, NULL);
+    dem_local_fraction(d, 1.5e-3, phi, NULL, NULL, NULL);
     const double ball15 = 4.0 / 3.0 * M_PI * pow(1.5e-3, 3);
     const double exA = (lens(1.5e-3, r, 1.05e-3) + lens(1.5e-3, r, 1.3e-3)) / (ball15 - V);
     const double sBC = sqrt(1.05e-3 * 1.05e-3 + 1.3e-3 * 1.3e-3);
     const double exB = (lens(1.5e-3, r, 1.05e-3) + lens(1.5e-3, r, sBC)) / (ball15 - V);
     printf("# local fraction, ball 1.5 mm: A %.6f (exact %.6f), B %.6f (exact %.6f)\n", phi[0], exA, phi[1], exB);
     assert_true(fabs(phi[0] - exA) < 1e-12 && fabs(phi[1] - exB) < 1e-12);
-    dem_local_fraction(d, 1.6e-3, phi, NULL, NULL);
+    dem_local_fraction(d, 1.6e-3, phi, NULL, NULL, NULL);
     const double ball16 = 4.0 / 3.0 * M_PI * pow(1.6e-3, 3);
     const double exB1 = (V + lens(1.6e-3, r, sBC)) / (ball16 - V); /* A whole inside B's ball */
     assert_true(fabs(phi[1] - exB1) < 1e-12);
@@ -303,7 +303,7 @@ static void test_local_fraction(void **state)
              "particle2 = center 0.005 0.0061 0.0005 radius 0.0005\n",
              "", "[boundary]\nx_lo = periodic\nx_hi = periodic\ny_lo = periodic\ny_hi = periodic\nz_lo = noslip\n"
              "z_hi = noslip\n");
-    dem_local_fraction(d, 1.5e-3, phi, NULL, NULL);
+    dem_local_fraction(d, 1.5e-3, phi, NULL, NULL, NULL);
     const double hcap = 1.5e-3 - 0.5e-3;
     const double inbox = ball15 - M_PI * hcap * hcap * (3 * 1.5e-3 - hcap) / 3;
     const double exW = lens(1.5e-3, r, 1.1e-3) / (inbox - V);

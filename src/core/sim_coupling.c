@@ -53,11 +53,14 @@ static const cfg_key_t coupling_keys[] = {
      "change since the fluid step, -K 3 pi eta D (U - U_n) and -K pi eta D^3 (omega - omega_n), so that a particle "
      "whose relaxation time is shorter than the fluid step is not driven by a stale force (docs/theory.md §9.1); "
      "0: the held force alone (the seed's)"},
-    {"coupling", "implicit_drag_hindrance", CFG_ENUM, "none", 1, 0, "none|richardson_zaki",
-     "implicit_drag > 0: the force coefficient K 3 pi eta D of every particle (none), or 3 pi eta D max(K, "
+    {"coupling", "implicit_drag_hindrance", CFG_ENUM, "none", 1, 0, "none|richardson_zaki|relative",
+     "implicit_drag > 0: the force coefficient K 3 pi eta D of every particle (none); or c_h = 3 pi eta D max(K, "
      "(1 - phi)^-4.65), phi the particle's local solid fraction (a ball of 1.5 mean diameters; at most 0.64) at the start of "
-     "the fluid step (richardson_zaki: a grain in a dense bed moves against the hindered drag of its "
-     "neighbourhood, tens of times an isolated sphere's; docs/theory.md §9.1b)"},
+     "the fluid step, on the whole velocity change (richardson_zaki), or on its part relative to the "
+     "neighbourhood's mean change, K on the rest, along the periodic directions (relative: a grain that moves "
+     "against its neighbours meets the hindered drag, a neighbourhood that moves together carries its pore fluid "
+     "along; along a direction bounded by walls it pushes the fluid through its pores: c_h on the whole change; "
+     "docs/theory.md §9.1b)"},
     {"coupling", "restitution_axis", CFG_VEC3, NULL, -1e300, 1e300, NULL,
      "wall: direction from the particle towards the wall (default: along gravity)", CFG_OPTIONAL},
     {NULL, NULL, 0, NULL, 0, 0, NULL, NULL},
@@ -572,6 +575,7 @@ void sim_add_coupling(sim_t *s, cfg_t *cfg, struct ibm *ibm)
     if (ibm && ibm->n > 0 && cfg_double(cfg, "coupling", "implicit_drag") > 0)
         coupling_drag_init(&cp->drag, ibm->n, cfg_double(cfg, "coupling", "implicit_drag"),
                            s->fluid->prm.rho * s->fluid->prm.nu, cfg_enum(cfg, "coupling", "implicit_drag_hindrance"));
+    if (cp->drag.n) coupling_drag_set_bounded(&cp->drag, s->fluid->g->periodic);
     /* the lubrication correction adds what the grid does not resolve: it needs the grid spacing
      * (before the packing preparation, whose lists must hold every lubricated pair) */
     if (ibm) dem_lubrication_set_grid(sim_dem_engine_unprepared(s), grid_min_spacing(s->fluid->g));

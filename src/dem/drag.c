@@ -133,9 +133,44 @@ static double ball_in_box(const dem_t *d, const double c[3], double R)
     return v;
 }
 
-void dem_local_fraction(const dem_t *d, double R, double *phi_by_id, double *ug_by_id, const double fallback[3])
+void dem_nbhood_free(dem_nbhood_t *h)
+{
+    free(h->beg);
+    free(h->end);
+    free(h->id);
+    free(h->w);
+    memset(h, 0, sizeof *h);
+}
+
+/* one more neighbour j (weight lv) of the particle whose list is being written */
+static void nbhood_add(dem_nbhood_t *h, long k, long j, double lv)
+{
+    if (k >= h->cap) {
+        long c = h->cap > 0 ? 2 * h->cap : 256;
+        h->id = realloc(h->id, (size_t)c * sizeof *h->id);
+        h->w = realloc(h->w, (size_t)c * sizeof *h->w);
+        if (!h->id || !h->w) die_local("dem: out of memory for %ld neighbourhood entries", c);
+        h->cap = c;
+    }
+    h->id[k] = j;
+    h->w[k] = lv;
+}
+
+void dem_local_fraction(const dem_t *d, double R, double *phi_by_id, double *ug_by_id, const double fallback[3],
+                        dem_nbhood_t *nbh)
 {
     const int n = d->n;
+    long nk = 0; /* entries of nbh written */
+    if (nbh) {
+        const long nid = dem_id_bound(d);
+        if (nbh->nid < nid) {
+            free(nbh->beg);
+            free(nbh->end);
+            nbh->beg = xcalloc((size_t)nid, sizeof *nbh->beg);
+            nbh->end = xcalloc((size_t)nid, sizeof *nbh->end);
+            nbh->nid = nid;
+        }
+    }
     double rmax = 0; /* of the particles now (d->rmax is set by the first neighbour-list build) */
     for (int i = 0; i < n; i++) rmax = fmax(rmax, d->r[i]);
     const double reach = R + rmax;
@@ -181,6 +216,7 @@ void dem_local_fraction(const dem_t *d, double R, double *phi_by_id, double *ug_
             }
         }
         double vs = 0, vu[3] = {0, 0, 0};
+        if (nbh) nbh->beg[d->id[i]] = nk;
         for (int qz = 0; qz < noff[2]; qz++)
             for (int qy = 0; qy < noff[1]; qy++)
                 for (int qx = 0; qx < noff[0]; qx++)
@@ -195,10 +231,12 @@ void dem_local_fraction(const dem_t *d, double R, double *phi_by_id, double *ug_
                         if (s2 < reach * reach) {
                             const double lv = lens_volume(R, d->r[j], sqrt(s2));
                             vs += lv;
+                            if (nbh) nbhood_add(nbh, nk++, d->id[j], lv);
                             if (!d->fixed[j])
                                 for (int a = 0; a < 3; a++) vu[a] += lv * d->v[3 * j + a];
                         }
                     }
+        if (nbh) nbh->end[d->id[i]] = nk;
         const double vol = ball_in_box(d, xi, R) - 4.0 / 3.0 * M_PI * d->r[i] * d->r[i] * d->r[i];
         double phi = vol > 0 ? vs / vol : 0.0;
         phi_by_id[d->id[i]] = phi < 0.95 ? phi : 0.95;
@@ -249,7 +287,7 @@ static void update_fraction(dem_t *d)
         memset(D->ug, 0, 3 * (size_t)d->next_id * sizeof *D->ug);
         D->nphi = d->next_id;
     }
-    dem_local_fraction(d, D->R, D->phi, D->ug, D->uf);
+    dem_local_fraction(d, D->R, D->phi, D->ug, D->uf, NULL);
     D->phi_step = d->step;
 }
 
