@@ -98,13 +98,14 @@ void coupling_forces_to_dem(const ibm_t *ibm, dem_t *d, double rho_fluid, const 
  * cross-section vanishes, a neighbourhood that moves together pushes the
  * fluid through its pores, and the whole change meets c_h as with
  * richardson_zaki (bounded[], coupling_drag_set_bounded). */
+typedef enum { DRAG_HINDRANCE_NONE, DRAG_HINDRANCE_RICHARDSON_ZAKI, DRAG_HINDRANCE_RELATIVE } drag_hindrance_t;
 typedef struct {
     int n;          /* spheres (0: off) */
     double k;       /* K */
     double mu;      /* dynamic viscosity η of the fluid */
     double *held;   /* 6n: the held force and torque of this step (by sphere) */
     long chunks;    /* DEM chunks done (statistics) */
-    int hindered;   /* implicit_drag_hindrance: 0 none, 1 richardson_zaki, 2 relative */
+    int hindered;   /* implicit_drag_hindrance (drag_hindrance_t, the order of the key's choices) */
     dem_nbhood_t nbh; /* relative: the neighbourhoods of this step */
     double *du;     /* relative: by id, 3 per particle, U − U_n at the start of a chunk (scratch) */
     unsigned char bounded[3]; /* relative: the directions bounded by walls (not periodic); all by default */

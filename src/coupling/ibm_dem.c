@@ -219,7 +219,7 @@ static void drag_factors(coupling_drag_t *dr, const dem_t *d)
     if (dr->hindered) {
         int clipped;
         dem_local_fraction(d, dem_fraction_radius(d, DRAG_FRACTION_RADIUS, &clipped), dr->phi, NULL, NULL,
-                           dr->hindered == 2 ? &dr->nbh : NULL);
+                           dr->hindered == DRAG_HINDRANCE_RELATIVE ? &dr->nbh : NULL);
     }
     double ps = 0, fm = 0;
     int nm = 0;
@@ -289,35 +289,34 @@ dem_status_t coupling_drag_advance(coupling_drag_t *dr, const ibm_t *ibm, dem_t 
         const unsigned char *fx = dem_fixed(d);
         fe = dem_ext_force(d);
         te = dem_ext_torque(d);
-        if (dr->hindered == 2)
-            for (int i = 0; i < n; i++) { /* every particle's change first: the means read them */
-                const long p = idn[i];
-                double U[3];
-                dem_full_velocity(d, i, U);
-                for (int a = 0; a < 3; a++) dr->du[3 * p + a] = fx[i] ? 0.0 : U[a] - ibm->s[p].u[a];
-            }
+        /* every particle's change ΔU = U − U_n first (the neighbourhood means read them) */
+        for (int i = 0; i < n; i++) {
+            const long p = idn[i];
+            double U[3];
+            dem_full_velocity(d, i, U);
+            for (int a = 0; a < 3; a++) dr->du[3 * p + a] = fx[i] ? 0.0 : U[a] - ibm->s[p].u[a];
+        }
         for (int i = 0; i < n; i++) {
             const long p = idn[i];
             const ibm_sphere_t *s = &ibm->s[p];
-            double U[3], c, cr, dum[3] = {0, 0, 0}, ck = 0;
-            dem_full_velocity(d, i, U);
+            const double *dU = dr->du + 3 * p;
+            double c, ck, cr, dum[3];
             drag_coefficients(dr, dr->factor[p], rn[i], &c, &cr);
-            if (dr->hindered == 2 && !fx[i]) {
-                /* ΔŪ, the neighbourhood's mean change (none in the ball: the particle's own, K alone) */
-                double ws = 0;
+            drag_coefficients(dr, dr->k, rn[i], &ck, &cr);
+            /* relative: ΔŪ, the neighbourhood's mean change (none in the ball: the particle's own, K alone) */
+            double ws = 0;
+            for (int a = 0; a < 3; a++) dum[a] = 0.0;
+            if (dr->hindered == DRAG_HINDRANCE_RELATIVE && !fx[i])
                 for (long k = dr->nbh.beg[p]; k < dr->nbh.end[p]; k++) {
-                    const long q = dr->nbh.id[k];
                     ws += dr->nbh.w[k];
-                    for (int a = 0; a < 3; a++) dum[a] += dr->nbh.w[k] * dr->du[3 * q + a];
+                    for (int a = 0; a < 3; a++) dum[a] += dr->nbh.w[k] * dr->du[3 * dr->nbh.id[k] + a];
                 }
-                for (int a = 0; a < 3; a++) dum[a] = ws > 0 ? dum[a] / ws : U[a] - s->u[a];
-                drag_coefficients(dr, dr->k, rn[i], &ck, &cr);
-            }
+            for (int a = 0; a < 3; a++) dum[a] = ws > 0 ? dum[a] / ws : dU[a];
             for (int a = 0; a < 3; a++) {
-                const double dU = U[a] - s->u[a];
-                const double F = fx[i]                                  ? 0.0
-                                 : dr->hindered == 2 && !dr->bounded[a] ? -ck * dU - (c - ck) * (dU - dum[a])
-                                                                        : -c * dU;
+                const double F = fx[i] ? 0.0
+                                 : dr->hindered == DRAG_HINDRANCE_RELATIVE && !dr->bounded[a]
+                                     ? -ck * dU[a] - (c - ck) * (dU[a] - dum[a])
+                                     : -c * dU[a];
                 fe[3 * i + a] = dr->held[6 * p + a] + F;
                 te[3 * i + a] = dr->held[6 * p + 3 + a] - (fx[i] ? 0.0 : cr * (w[3 * i + a] - s->omega[a]));
                 if (am && !fx[i]) am->slow[3 * p + a] += span * F / dem_mass(d, i);
