@@ -286,6 +286,120 @@ static void test_build_sums_exact(void **state)
                      "2-D discs");
 }
 
+/* ---- radius_correction = gaps: the neighbour lists against brute force -------------- */
+
+typedef struct {
+    double v[4];
+} nb_entry_t;
+
+static int by_entry(const void *a, const void *b)
+{
+    const double *x = ((const nb_entry_t *)a)->v, *y = ((const nb_entry_t *)b)->v;
+    for (int q = 0; q < 4; q++)
+        if (x[q] != y[q]) return x[q] < y[q] ? -1 : 1;
+    return 0;
+}
+
+/* The cell-list neighbours of every sphere (offset of the neighbour's centre
+ * and its radius) against every other sphere at every periodic image within
+ * reach: the same entries, offsets within round-off.  n spheres of radius
+ * 0.5 ± 10 % (seeded) in a box of L × L × H (periodic in x and y, walls in z)
+ * at D/Δx = dpd; returns the number of entries. */
+static long check_gap_lists(int n, double L, double H, int dpd, unsigned seed)
+{
+    char text[512];
+    int nx = (int)lround(L * dpd), nz = (int)lround(H * dpd);
+    snprintf(text, sizeof text,
+             "[domain]\nnx = %d\nny = %d\nnz = %d\nlength = %g %g %g\n"
+             "[boundary]\nz_lo = noslip\nz_hi = noslip\n[fluid]\nnu = 1\n"
+             "[ibm]\nradius_correction = gaps\n",
+             nx, nx, nz, L, L, H);
+    ibm_sphere_t *sp = xcalloc((size_t)n, sizeof *sp);
+    srand(seed);
+    for (int p = 0; p < n; p++) {
+        double u[4];
+        for (int q = 0; q < 4; q++) u[q] = rand() / (RAND_MAX + 1.0);
+        sp[p].kind = IBM_EXTERNAL;
+        sp[p].radius = 0.45 + 0.1 * u[3];
+        const double c[3] = {L * u[0], L * u[1], 0.7 + (H - 1.4) * u[2]};
+        memcpy(sp[p].x, c, sizeof c);
+        memcpy(sp[p].xa, c, sizeof c);
+    }
+    it_case_t tc;
+    tc.cfg = cfg_load_string("test.ini", text, 0, NULL);
+    tc.g = grid_create_from_config(tc.cfg, MPI_COMM_WORLD);
+    fluid_params_t prm;
+    fluid_params_from_config(tc.cfg, tc.g, &prm);
+    tc.f = fluid_create(tc.g, &prm);
+    fluid_init_from_config(tc.f, tc.cfg);
+    tc.ibm = ibm_create_from_config_with(tc.cfg, tc.f, sp, n);
+    free(sp);
+    /* a moving bed's centres may sit a period away (the list wraps them): shift some by ±L */
+    for (int p = 0; p < n; p += 3) tc.ibm->s[p].xa[p % 2] += (p % 4 ? L : -L);
+    ibm_t *ibm = tc.ibm;
+    const grid_t *g = tc.g;
+    ibm_build_nodes(ibm, NULL, 0);
+    const ibm_priv_t *q = ibm_priv(ibm);
+    /* the reach of gap_neighbours: the sphere, its band, the largest thickening, 1.5 cells and the cutoff */
+    double hmax = fmax(g->dy, g->dz);
+    for (int i = 0; i < g->n[0]; i++) hmax = fmax(hmax, g->gdxf[i]);
+    const double margin = (ibm_band_halfwidth() + IBM_GAP_MAX + 1.5) * hmax;
+    nb_entry_t *ref = xcalloc(27 * 27 * (size_t)n, sizeof *ref), *got = NULL;
+    long total = 0;
+    double worst = 0.0;
+    for (int p = 0; p < n; p++) {
+        const ibm_sphere_t *s = &ibm->s[p];
+        const double reach = s->radius + margin + IBM_GAP_CUTOFF_D * 2.0 * s->radius;
+        long nr = 0;
+        const int ni = (int)ceil((reach + 0.55) / L) + 1; /* every image that may be within reach */
+        for (int o = 0; o < n; o++)
+            for (int i = -ni; i <= ni; i++)
+                for (int j = -ni; j <= ni; j++) {
+                    if (o == p && i == 0 && j == 0) continue;
+                    double off[3] = {ibm->s[o].xa[0] - s->xa[0] + i * L, ibm->s[o].xa[1] - s->xa[1] + j * L,
+                                     ibm->s[o].xa[2] - s->xa[2]};
+                    if (sqrt(off[0] * off[0] + off[1] * off[1] + off[2] * off[2]) - ibm->s[o].radius >= reach) continue;
+                    assert_true(nr < 27 * 27 * n);
+                    ref[nr++] = (nb_entry_t){{off[0], off[1], off[2], ibm->s[o].radius}};
+                }
+        const long m = q->nb_head[p + 1] - q->nb_head[p];
+        assert_int_equal(m, nr);
+        got = realloc(got, (size_t)(m > 0 ? m : 1) * sizeof *got);
+        for (long e = 0; e < m; e++) {
+            const double *x = q->nb + IBM_NB_STRIDE * (q->nb_head[p] + e);
+            memcpy(got[e].v, x, sizeof got[e].v);
+            /* in increasing distance from p's centre to the neighbour's surface, which the entry carries */
+            assert_true(fabs(x[4] - (sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) - x[3])) < 1e-14);
+            if (e > 0) assert_true(x[4] >= x[4 - IBM_NB_STRIDE]);
+        }
+        /* sorted by offset: neighbours the two sides place within round-off of each other stay paired
+         * unless two entries share an x offset to ~1e-15 (not in these seeded scenes) */
+        qsort(ref, (size_t)nr, sizeof *ref, by_entry);
+        qsort(got, (size_t)m, sizeof *got, by_entry);
+        for (long e = 0; e < m; e++)
+            for (int c = 0; c < 4; c++) worst = fmax(worst, fabs(got[e].v[c] - ref[e].v[c]));
+        total += m;
+    }
+    print_message("  gaps' neighbour lists, %d spheres in %g x %g x %g (D/dx %d): %ld entries, "
+                  "largest offset difference from brute force %.1e\n",
+                  n, L, L, H, dpd, total, worst);
+    /* the same offsets up to the rounding of whole periods added to centre differences */
+    assert_true(worst < 1e-12 * L);
+    free(ref);
+    free(got);
+    it_free(&tc);
+    return total;
+}
+
+static void test_gap_lists_against_brute_force(void **state)
+{
+    (void)state;
+    /* a box narrower than the reach (~2.6 D): several images of every sphere, one cell per period */
+    assert_true(check_gap_lists(12, 2.2, 4.0, 8, 7u) > 12 * 20);
+    /* a wide box: several cells per period (the images across the faces from neighbouring cells) */
+    assert_true(check_gap_lists(60, 12.0, 5.0, 4, 11u) > 60 * 5);
+}
+
 /* ---- cost ---------------------------------------------------------------------------- */
 
 /* The same sphere at the same Δx in boxes of 24³ and 48³ cells has the
@@ -322,6 +436,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_volume_axi_2d),
         cmocka_unit_test(test_lists_against_brute_force),
         cmocka_unit_test(test_build_sums_exact),
+        cmocka_unit_test(test_gap_lists_against_brute_force),
         cmocka_unit_test(test_cost_independent_of_grid),
     };
     TEST_MPI_RUN("ibm_alpha", tests);

@@ -179,76 +179,12 @@ static double plane_cell_size(const grid_t *g, int c, int il)
     return g->dim == 3 ? cbrt(hx * g->dy * g->dz) : sqrt(hx * g->dy);
 }
 
-/* ---- radius_correction = gaps: the local thickening --------------------------- */
+/* ---- radius_correction = gaps: the margin (the neighbours and the thickening: alpha_gaps.c) */
 
 /* The most the forced radius grows beyond ibm_forced_radius(), in cells. */
 static inline double gap_margin(const ibm_t *ibm)
 {
     return ibm->prm.radius_calibrated == IBM_RADIUS_GAPS ? IBM_GAP_MAX : 0.0;
-}
-
-/* The neighbour lists of ibm_priv_t (nb_head, nb) at the centres xa: for
- * sphere p, every other sphere and every periodic image (its own included)
- * whose surface may come within the cutoff of a node of p's band.  O(N²)
- * per build, with the periodic images. */
-static void gap_neighbours(ibm_t *ibm)
-{
-    const grid_t *g = ibm->g;
-    ibm_priv_t *q = ibm_priv(ibm);
-    double hmax = fmax(g->dy, g->dz), rmax = 0.0;
-    for (int i = 0; i < g->n[0]; i++) hmax = fmax(hmax, g->gdxf[i]);
-    for (int p = 0; p < ibm->n; p++) rmax = fmax(rmax, ibm->s[p].radius);
-    const double margin = (ibm_band_halfwidth() + IBM_GAP_MAX + 1.5) * hmax;
-    if (!q->nb_head) q->nb_head = xcalloc((size_t)ibm->n + 1, sizeof *q->nb_head); /* ibm->n is fixed */
-    long cnt = 0;
-    for (int p = 0; p < ibm->n; p++) {
-        const ibm_sphere_t *s = &ibm->s[p];
-        const double reach = s->radius + margin + IBM_GAP_CUTOFF_D * 2.0 * s->radius; /* from p's centre */
-        int ns[3] = {0, 0, 0};
-        for (int d = 0; d < 3; d++)
-            if (d < g->dim && g->periodic[d]) ns[d] = (int)ceil((reach + rmax) / g->L[d]);
-        q->nb_head[p] = (int32_t)cnt;
-        for (int o = 0; o < ibm->n; o++) {
-            double off0[3];
-            for (int d = 0; d < 3; d++) {
-                off0[d] = ibm->s[o].xa[d] - s->xa[d];
-                if (ns[d] > 0) off0[d] -= g->L[d] * round(off0[d] / g->L[d]);
-            }
-            for (int i = -ns[0]; i <= ns[0]; i++)
-                for (int j = -ns[1]; j <= ns[1]; j++)
-                    for (int k = -ns[2]; k <= ns[2]; k++) {
-                        double off[3] = {off0[0] + i * g->L[0], off0[1] + j * g->L[1], off0[2] + k * g->L[2]};
-                        double dist = sqrt(off[0] * off[0] + off[1] * off[1] + off[2] * off[2]);
-                        if (o == p && i == 0 && j == 0 && k == 0) continue;
-                        if (dist - ibm->s[o].radius >= reach) continue;
-                        if (cnt + 1 > q->cap_nb) {
-                            long c = q->cap_nb > 0 ? 2 * q->cap_nb : 64;
-                            q->nb = realloc(q->nb, (size_t)c * 4 * sizeof *q->nb);
-                            if (!q->nb) die_local("immersed boundary: out of memory for %ld neighbours", c);
-                            q->cap_nb = c;
-                        }
-                        double *e = q->nb + 4 * cnt++;
-                        e[0] = off[0], e[1] = off[1], e[2] = off[2], e[3] = ibm->s[o].radius;
-                    }
-        }
-    }
-    q->nb_head[ibm->n] = (int32_t)cnt;
-}
-
-/* The local thickening (length) of sphere p's forced radius at offset r
- * from its centre, cell size h: ibm_gap_thickening() of the distance to
- * the nearest neighbour's surface, clamped to [0, IBM_GAP_CUTOFF_D D_p]. */
-static double gap_extra(const ibm_t *ibm, int p, const double r[3], double h)
-{
-    const ibm_priv_t *q = ibm_priv(ibm);
-    double G = IBM_GAP_CUTOFF_D * 2.0 * ibm->s[p].radius;
-    for (long e = q->nb_head[p]; e < q->nb_head[p + 1]; e++) {
-        const double *n = q->nb + 4 * e;
-        double x = r[0] - n[0], y = r[1] - n[1], z = r[2] - n[2];
-        double Gq = sqrt(x * x + y * y + z * z) - n[3];
-        if (Gq < G) G = Gq;
-    }
-    return ibm_gap_thickening(G > 0.0 ? G : 0.0, h);
 }
 
 /* Most segments plane_segments() writes for a box lo..hi: two per grid
@@ -428,7 +364,7 @@ static void alpha_runs(const ibm_t *ibm, ibm_run_t *runs, long nr, double h, lon
                 for (int k = 0; k < len; k++) {
                     double r[3] = {run->r0[0], run->r0[1], run->r0[2]};
                     r[rd] = z[e + k];
-                    reff[e + k] += gap_extra(ibm, run->p, r, h);
+                    reff[e + k] += ibm_gap_extra(ibm, run->p, r, h);
                 }
             e += len;
             ep += len;
@@ -449,7 +385,7 @@ static void alpha_runs(const ibm_t *ibm, ibm_run_t *runs, long nr, double h, lon
             if (gaps) {
                 double r[3] = {run->r0[0], run->r0[1], run->r0[2]};
                 r[rd] = z[e];
-                reff[e] += gap_extra(ibm, run->p, r, h);
+                reff[e] += ibm_gap_extra(ibm, run->p, r, h);
             }
             e++;
         }
@@ -626,7 +562,7 @@ void ibm_build_nodes(ibm_t *ibm, double *mom, int targets)
     ibm_priv_t *q = ibm_priv(ibm);
     if (alpha_tmax == 0.0) alpha_table_init();
     q->nruns = q->n_nruns = q->nnodes = q->nalpha = q->nshared = 0;
-    if (ibm->prm.radius_calibrated == IBM_RADIUS_GAPS) gap_neighbours(ibm);
+    if (ibm->prm.radius_calibrated == IBM_RADIUS_GAPS) ibm_gap_neighbours(ibm);
     if (mom) ibm_sums_zero(ibm, mom, 0, 1);
     if (targets) ibm_targets_note(ibm);
     int *box = xcalloc(7 * (size_t)(ibm->n > 0 ? ibm->n : 1), sizeof *box); /* lo[3], hi[3], in the domain */
@@ -730,7 +666,7 @@ void ibm_solid_fraction_cell(const ibm_t *ibm, double *out)
                 for (int k = 0; k < seg[e].len; k++, r[q->rdir] += q->rstep) {
                     long m = seg[e].m0 + k * q->rstride;
                     double Rf = ibm_forced_radius(ibm, ibm->s[p].radius, h);
-                    if (ibm->prm.radius_calibrated == IBM_RADIUS_GAPS) Rf += gap_extra(ibm, p, r, h);
+                    if (ibm->prm.radius_calibrated == IBM_RADIUS_GAPS) Rf += ibm_gap_extra(ibm, p, r, h);
                     double a = out[m] + alpha_at(Rf, band, r, h);
                     out[m] = a > 1.0 ? 1.0 : a;
                 }

@@ -55,7 +55,7 @@ static const cfg_key_t ibm_keys[] = {
      "forcing_iterations = 0; see docs/theory.md); gaps (3-D): the radius R - (r(κ) - 0.084 Δx/R) Δx + "
      "min(0.45 Δx²/(G + Δx), 0.4 Δx) at each node, G its distance to the nearest other sphere's surface "
      "(at most 2 diameters): also corrects the narrow gaps of dense arrays and beds (same conditions; the "
-     "neighbour search costs O(N²) per rebuild of the solid fraction); none: the seed's volume fraction"},
+     "neighbour search, a cell list, costs O(N) per rebuild of the solid fraction); none: the seed's volume fraction"},
     {"ibm", "spheres_file", CFG_STRING, NULL, 1, 0, NULL,
      "many spheres: a CSV file (header with x,y,z,radius or diameter; optional density,u,v,w,ox,oy,oz,kind or "
      "fixed) or an HDF5 packing (.h5: datasets position [n][3], radius; optional density, velocity, omega, fixed)", CFG_CONDITIONAL},

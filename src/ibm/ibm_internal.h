@@ -93,13 +93,24 @@ typedef struct {
      * spheres and the periodic images of all, itself included) whose surface
      * may come within IBM_GAP_CUTOFF_D diameters of its band: nb[nb_head[p]
      * .. nb_head[p + 1]), each the offset of the neighbour's centre from
-     * sphere p's and its radius (x, y, z, R); built with the node lists */
+     * sphere p's, its radius and the distance from p's centre to its
+     * surface (x, y, z, R, |x| − R: IBM_NB_STRIDE doubles), in increasing
+     * order of that distance; built with the node lists */
     int32_t *nb_head;
     double *nb;
     long cap_nb;
 } ibm_priv_t;
 
+#define IBM_NB_STRIDE 5 /* doubles per entry of ibm_priv_t.nb */
+
 static inline ibm_priv_t *ibm_priv(const ibm_t *ibm) { return (ibm_priv_t *)ibm->priv; }
+
+/* alpha_gaps.c (radius_correction = gaps) */
+/* The neighbour lists nb_head, nb at the centres xa (a cell list, O(N)). */
+void ibm_gap_neighbours(ibm_t *ibm);
+/* The local thickening (length) of sphere p's forced radius at offset r
+ * from its centre, cell size h. */
+double ibm_gap_extra(const ibm_t *ibm, int p, const double r[3], double h);
 
 /* alpha.c */
 /* First global index whose node coordinate is >= x along a non-periodic x
