@@ -3,7 +3,7 @@
 # (docs/validation.md "Immersed avalanche"; cases/avalanche/README.md).
 #   map         the regime map: rho_p/rho in {2.7, 4, 10, 40, 100} x St in {0.05, 0.3, 1, 4.5, 20, 100}
 #               (30 runs) and the seven cases of Table 4.3, in the quick box (coarse.ini: 3 D x 3 D,
-#               D/dx = 5) with the thesis' contacts to 300 sqrt(D/g) (or 40 T_v if longer), averaged from 150
+#               D/dx = 5) with the thesis' contacts to 300 sqrt(D/g) (or 80 T_v if longer), averaged from 150
 #               sqrt(D/g) (or over the second half)
 #   table       the seven cases of Table 4.3 alone, in the quick box as for map
 #   production  the seven cases of Table 4.3 in the production box (case.ini: 5 D x 5 D x 20 D,
@@ -51,10 +51,11 @@ run_set() { # SET CASE T_END_G AVG_FROM_G "RATIO:ST ..." [--set options of every
         [ -f "$dir/summary.json" ] && continue # done already
         local opts tv te ta
         opts=$($PY scripts/avalanche_set.py "$ratio" "$st" 2>/dev/null)
-        # a viscous bed triggers after ~20 T_v (case 2: ~70 sqrt(D/g) in the quick box, 37 in the
-        # production one): runs of small St last 40 T_v, averaged over the second half
+        # a viscous bed triggers after ~10-30 T_v (case 2: ~70 sqrt(D/g) = 17 T_v in the quick box, 37 in
+        # the production one; St ~0.05 at 20-28 T_v in the quick box): runs of small St last 80 T_v,
+        # averaged over the second half (after the triggering)
         tv=$($PY scripts/avalanche_set.py "$ratio" "$st" 2>&1 >/dev/null | sed 's/.*T_v = \([0-9.e+-]*\).*/\1/')
-        te=$($PY -c "print(max($tend, 40 * $tv))")
+        te=$($PY -c "print(max($tend, 80 * $tv))")
         ta=$($PY -c "print($avg if $te == $tend else $te / 2)")
         $BIN run "$case" $opts $extra --set output.progress=off --set output.overwrite=true \
             --set time.t_end=$($PY -c "print($te * $TG)") \
