@@ -159,8 +159,11 @@ def table42(rows):
 
 
 def find(rows, ratio, st):
-    return next((k for k, r in enumerate(rows) if abs(r["ratio"] / ratio - 1) < 1e-6 and abs(r["St"] / st - 1) < 0.05),
-                None)
+    """The run of this density ratio whose St is nearest st (within 5 %; the map's St 0.3 and Table 4.3's
+    0.31 are both within it), or None."""
+    near = [(abs(r["St"] / st - 1), k) for k, r in enumerate(rows)
+            if abs(r["ratio"] / ratio - 1) < 1e-6 and abs(r["St"] / st - 1) < 0.05]
+    return min(near)[1] if near else None
 
 
 def profile_targets(runs, rows):

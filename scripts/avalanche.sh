@@ -43,7 +43,7 @@ table43="4:0.04 4:0.31 4:7.75 4:75.4 100:0.45 100:4.5 100:111.2"
 # 3 % (not the target's 1 %, which each run's table row is read against: its largest overlap).
 STIFF="--set contact.contact_time=9.93e-5 --set dem.max_overlap=0.03"
 run_set() { # SET CASE T_END_G AVG_FROM_G "RATIO:ST ..." [--set options of every run]
-    local set=$1 case=$2 tend=$3 avg=$4 list=$5 extra=${6:-} dirs=() pids=()
+    local set=$1 case=$2 tend=$3 avg=$4 list=$5 extra=${6:-} dirs=()
     for rs in $list; do
         local ratio=${rs%%:*} st=${rs##*:} dir="$OUT/$set/r${rs%%:*}_St${rs##*:}"
         dirs+=("$dir")
@@ -60,8 +60,8 @@ run_set() { # SET CASE T_END_G AVG_FROM_G "RATIO:ST ..." [--set options of every
         $BIN run "$case" $opts $extra --set output.progress=off --set output.overwrite=true \
             --set time.t_end=$($PY -c "print($te * $TG)") \
             --set avalanche.average_from=$($PY -c "print($ta * $TG)") --out "$dir" >"$dir.log" 2>&1 &
-        pids+=($!)
-        if [ ${#pids[@]} -ge "$JOBS" ]; then wait "${pids[0]}"; pids=("${pids[@]:1}"); fi
+        # a slot frees when any run ends (a short run next to a long one does not hold a core idle)
+        while [ "$(jobs -pr | wc -l)" -ge "$JOBS" ]; do wait -n; done
     done
     wait
     post "$set" "${dirs[@]}"
