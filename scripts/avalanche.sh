@@ -16,7 +16,7 @@
 #   convergence target 8: Table 4.3's cases 2 (viscous) and 3 (inertial) in the quick box (coarse.ini with the
 #               thesis' contacts) at D/dx in CONV_RES (default "5 8 10"), from a flowing bed (case 2 at D/dx 5
 #               from coarse_bed.h5 to 150 sqrt(D/g)), 60 sqrt(D/g) averaged from 30 (CONV_WINDOW="T_END AVG_FROM");
-#               one run at a time;
+#               one run at a time; CONV_CASES (default "0.31 7.75") the cases' St;
 #               OUT/convergence/case2.md and case3.md compare each resolution with the finest
 #   post SET    no run: post-processes the runs of OUT/SET (map, table or production) that finished
 #               (those with a summary.json), e.g. while the set runs or after it was stopped
@@ -108,7 +108,7 @@ convergence() {
             --set time.t_end=$(g 150) --set avalanche.average_from=$(g 100) --out "$flow" >"$flow.log" 2>&1
         $PY scripts/checkpoint_particles.py "$(ls "$flow"/checkpoint_*.h5 | tail -1)" "$flow.h5"
     fi
-    for c in 0.31 7.75; do
+    for c in ${CONV_CASES:-0.31 7.75}; do
         dirs=()
         for n in ${CONV_RES:-5 8 10}; do
             dir="$OUT/convergence/St${c}_res$n"
