@@ -52,7 +52,7 @@ run_set() { # SET CASE T_END_G AVG_FROM_G "RATIO:ST ..." [--set options of every
         local opts tv te ta
         opts=$($PY scripts/avalanche_set.py "$ratio" "$st" 2>/dev/null)
         # a viscous bed triggers after ~10-30 T_v (case 2: ~70 sqrt(D/g) = 17 T_v in the quick box, 37 in
-        # the production one; St ~0.05 at 20-28 T_v in the quick box): runs of small St last 80 T_v,
+        # the production one; St ~0.05 at 7-27 T_v in the quick box, lighter grains later): runs of small St last 80 T_v,
         # averaged over the second half (after the triggering)
         tv=$($PY scripts/avalanche_set.py "$ratio" "$st" 2>&1 >/dev/null | sed 's/.*T_v = \([0-9.e+-]*\).*/\1/')
         te=$($PY -c "print(max($tend, 80 * $tv))")
