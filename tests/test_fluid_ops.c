@@ -797,6 +797,8 @@ static void test_bad_input(void **state)
     /* accepted */
     assert_string_equal(try_case("2d", chan, "nu = 0.1\ninit = laminar\nbody_force = 1 0 0"), "");
     assert_string_equal(try_case("3d", per, "nu = 0.1\ninit = abc"), "");
+    assert_string_equal(try_case("3d", "y_lo = noslip\ny_hi = noslip\nz_lo = noslip\nz_hi = noslip",
+                                 "nu = 0.1\ninit = laminar\nbody_force = 1 0 0"), "");
     /* missing, out of range, wrong type: the parser and the getters */
     expect_error("2d", per, "rho = 2", "fluid.nu: missing key");
     expect_error("2d", per, "nu = -1", "case.ini:10: fluid.nu: -1 is out of range");
@@ -813,7 +815,16 @@ static void test_bad_input(void **state)
     expect_error("2d", per, "nu = 0.1\ninit = abc", "fluid.init: abc needs a triply periodic 3d grid");
     expect_error("2d", per, "nu = 0.1\ninit = laminar", "fluid.init: laminar needs one wall-bounded direction");
     expect_error("2d", "x_lo = noslip\nx_hi = noslip\ny_lo = noslip\ny_hi = noslip", "nu = 0.1\ninit = laminar",
-                 "fluid.init: laminar needs exactly one wall-bounded direction");
+                 "fluid.init: laminar needs one wall-bounded direction, or two in a 3d duct");
+    const char *duct = "y_lo = noslip\ny_hi = noslip\nz_lo = noslip\nz_hi = noslip";
+    expect_error("3d", "x_lo = noslip\nx_hi = noslip\ny_lo = noslip\ny_hi = noslip\nz_lo = noslip\nz_hi = noslip",
+                 "nu = 0.1\ninit = laminar", "fluid.init: laminar needs one wall-bounded direction, or two in a 3d duct");
+    expect_error("3d", "y_lo = noslip\ny_hi = noslip\nz_lo = noslip\nz_hi = freeslip", "nu = 0.1\ninit = laminar",
+                 "fluid.init: laminar in a duct needs no-slip walls on both z faces");
+    expect_error("3d", "y_lo = noslip\ny_hi = noslip\ny_hi_velocity = 1 0 0\nz_lo = noslip\nz_hi = noslip",
+                 "nu = 0.1\ninit = laminar", "boundary.y_hi_velocity: laminar in a duct needs walls at rest");
+    expect_error("3d", duct, "nu = 0.1\nbody_force = 1 0 1\ninit = laminar",
+                 "fluid.body_force: laminar in a duct needs the body force along the duct (x) only");
     expect_error("2d", "y_lo = noslip\ny_hi = freeslip", "nu = 0.1\ninit = laminar",
                  "fluid.init: laminar needs no-slip walls");
     expect_error("2d", chan, "nu = 0.1\nwall_ghost = cubic", "case.ini:12: fluid.wall_ghost: 'cubic' is not one of");

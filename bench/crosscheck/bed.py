@@ -5,10 +5,10 @@ import json
 import math
 import os
 import re
-import shutil
 import sys
 
-from common import ROOT, cpu_of, periodic_cube_ini, find_dat, foam_case, foam_env, foam_write, richardson
+from common import (ROOT, cached_or_fresh, cpu_of, drop_snapshots, periodic_cube_ini, find_dat, foam_case, foam_env,
+                    foam_mesh, foam_solve_at_flux, plot_speed_error, richardson, write_report)
 
 BED = os.environ.get("CROSSCHECK_BED", "bench/crosscheck/bed30.csv")  # another bed: a CSV of the same layout
 BED_CASES = {
@@ -61,10 +61,9 @@ def run_ibm_bed(name, n, corr, out):
     re_t = cs["re_target"]
     d = os.path.join(out, name, "ibm_%s_n%d" % (corr, n))
     res = os.path.join(d, "result.json")
-    if os.path.exists(res):
-        return json.load(open(res))
-    shutil.rmtree(d, ignore_errors=True)
-    os.makedirs(d)
+    cached = cached_or_fresh(d)
+    if cached:
+        return cached
     ini = os.path.join(d, "case.ini")
     with open(ini, "w") as fh:
         fh.write(BED_INI.format(head=periodic_cube_ini(n, L), bed=BED, f0=bed_guess_drive(re_t, L), re=re_t,
@@ -95,9 +94,7 @@ def run_ibm_bed(name, n, corr, out):
         sys.exit("crosscheck: %s: the spheres' drag is %.4g of the drive (status %s after %s steps): not a steady "
                  "state" % (d, r["balance"], r["status"], r["steps"]))
     json.dump(r, open(res, "w"), indent=1)
-    for x in os.listdir(os.path.join(d, "out")):
-        if x.startswith("checkpoint_") or x.startswith("fields_"):
-            os.remove(os.path.join(d, "out", x))
+    drop_snapshots(os.path.join(d, "out"))
     return r
 
 
@@ -226,19 +223,13 @@ def run_foam_bed(name, N, out):
     U = cs["re_target"]  # D = nu = 1
     d = os.path.join(out, name, "foam_N%d" % N)
     res = os.path.join(d, "result.json")
-    if os.path.exists(res):
-        return json.load(open(res))
-    shutil.rmtree(d, ignore_errors=True)
-    os.makedirs(d)
+    cached = cached_or_fresh(d)
+    if cached:
+        return cached
     foam_bed_case(d, L, xs, N, U)
     env = foam_env()
-    cpu_mesh = 0.0
-    for cmd in (["blockMesh"], ["snappyHexMesh", "-overwrite"], ["checkMesh"]):
-        cpu, _ = cpu_of(cmd, d, os.path.join(d, "log." + cmd[0]), env)
-        cpu_mesh += cpu
-    cm = open(os.path.join(d, "log.checkMesh")).read()
-    vol = float(re.search(r"Total volume = ([-+0-9.eE]+?)\.?\s", cm).group(1))
-    mesh_ok = "Mesh OK." in cm
+    cpu_mesh, _, vol = foam_mesh(d, env)
+    mesh_ok = "Mesh OK." in open(os.path.join(d, "log.checkMesh")).read()
     sn = open(os.path.join(d, "log.snappyHexMesh")).read()
     # the layer table's rows: patch, faces, layers, thickness [m], thickness [%]
     lay = re.findall(r"^(s\d\d_\d+)\s+(\d+)\s+([0-9.]+)\s+([0-9.eE+-]+)\s+([0-9.]+)\s*$", sn, re.M)[-len(bed_images(L, xs)):]  # the last (final) table
@@ -246,16 +237,7 @@ def run_foam_bed(name, N, out):
     layers = (sum(int(x[1]) * float(x[2]) for x in lay) / nf, sum(int(x[1]) * float(x[4]) for x in lay) / nf) \
         if nf else (0.0, 0.0)
     Ubar = U * L ** 3 / vol
-    foam_write(d, "constant/fvOptions", "dictionary", """drive
-{
-    type meanVelocityForce;
-    selectionMode all;
-    fields (U);
-    Ubar (%r 0 0);
-    relaxation 1.0;
-}
-""" % Ubar)
-    cpu_solve, wall = cpu_of(["simpleFoam"], d, os.path.join(d, "log.simpleFoam"), env, may_fail=True)
+    cpu_solve, wall = foam_solve_at_flux(d, env, Ubar)
     r = foam_bed_result(d, name, N, L, xs)
     r.update(mesh_ok=mesh_ok, layers_mean=layers[0], layers_thickness_percent=layers[1],
              cpu=cpu_mesh + cpu_solve, cpu_mesh=cpu_mesh, cpu_solve=cpu_solve, wall=wall)
@@ -360,12 +342,7 @@ def report_bed(out):
                     "no extrapolation (fewer than three runs)"
             lines.append("| %s | %s | %s | | | | | | | | | | | |" % (code, meth, exs))
             table[name]["series"]["%s/%s" % (code, meth)] = dict(runs=rs, extrapolation=ex, monotone=ok, order=p)
-            ax2.loglog([r["cpu"] for r in rs if r is not foam[-1]], [100 * r["cmp"]["rms"] for r in rs if r is not foam[-1]],
-                       "o-" if code == "OpenFOAM" else "s--", label="%s (%s)" % (code, meth))
-            for r in rs:
-                if r is not foam[-1]:
-                    ax2.annotate("%.0f" % r["dpdx"], (r["cpu"], 100 * r["cmp"]["rms"]), fontsize=7,
-                                 textcoords="offset points", xytext=(3, 3))
+            plot_speed_error(ax2, [r for r in rs if r is not foam[-1]], lambda r: 100 * r["cmp"]["rms"], code, meth)
             if code != "OpenFOAM":
                 ax1.plot(ref, rs[-1]["K"], "s", ms=4, label="ibmdem %s, D/dx = %.1f" % (meth, rs[-1]["dpdx"]))
             elif len(rs) > 1:
@@ -383,12 +360,7 @@ def report_bed(out):
         ax2.axhline(5.0, color="grey", lw=0.5)
         ax2.grid(True, which="both", lw=0.3)
         ax2.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "bed.png"), dpi=120)
-    with open(os.path.join(out, "bed_table.md"), "w") as fh:
-        fh.write("\n".join(lines) + "\n")
-    json.dump(table, open(os.path.join(out, "bed_table.json"), "w"), indent=1)
-    print("\n".join(lines))
+    write_report(out, "bed", fig, lines, table)
 
 
 # ---------------------------------------------------------------- extrapolation and report

@@ -4,6 +4,7 @@ cyclic cube with its function objects' output, and Richardson extrapolation."""
 import os
 import re
 import resource
+import shutil
 import subprocess
 import sys
 import time
@@ -21,6 +22,74 @@ def cpu_of(cmd, cwd, log, env=None, may_fail=False):
     if p.returncode != 0 and not may_fail:
         sys.exit("crosscheck: %s failed (exit %d), see %s" % (" ".join(cmd), p.returncode, log))
     return (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime), time.time() - t0
+
+def cached_or_fresh(d):
+    """the result.json of a run directory d if there is one; else None with d emptied and created"""
+    import json
+    res = os.path.join(d, "result.json")
+    if os.path.exists(res):
+        return json.load(open(res))
+    shutil.rmtree(d, ignore_errors=True)
+    os.makedirs(d)
+    return None
+
+
+def foam_solve_at_flux(d, env, Ubar):
+    """simpleFoam with the flow rate held (fvOption meanVelocityForce: the mean velocity over the
+    fluid cells is Ubar along x); a run that does not converge is not fatal.  (CPU s, wall s)"""
+    foam_write(d, "constant/fvOptions", "dictionary", """drive
+{
+    type meanVelocityForce;
+    selectionMode all;
+    fields (U);
+    Ubar (%r 0 0);
+    relaxation 1.0;
+}
+""" % Ubar)
+    return cpu_of(["simpleFoam"], d, os.path.join(d, "log.simpleFoam"), env, may_fail=True)
+
+
+def plot_speed_error(ax, runs, err, code, meth):
+    """one series on a speed-against-error plot: CPU seconds against err(run) (%), each point
+    labelled with its D/dx"""
+    ax.loglog([r["cpu"] for r in runs], [err(r) for r in runs], "o-" if code == "OpenFOAM" else "s--",
+              label="%s (%s)" % (code, meth))
+    for r in runs:
+        ax.annotate("%.0f" % r["dpdx"], (r["cpu"], err(r)), fontsize=7, textcoords="offset points", xytext=(3, 3))
+
+
+def write_report(out, stem, fig, lines, table):
+    """a report's figure OUT/stem.png, table OUT/stem_table.md (or table.md for stem "speed_error")
+    and .json, and the table on stdout"""
+    import json
+    fig.tight_layout()
+    fig.savefig(os.path.join(out, stem + ".png"), dpi=120)
+    name = "table" if stem == "speed_error" else stem + "_table"
+    with open(os.path.join(out, name + ".md"), "w") as fh:
+        fh.write("\n".join(lines) + "\n")
+    json.dump(table, open(os.path.join(out, name + ".json"), "w"), indent=1)
+    print("\n".join(lines))
+
+
+def foam_mesh(d, env):
+    """blockMesh, snappyHexMesh and checkMesh in the case d: (CPU seconds, cells, fluid volume)"""
+    cpu_mesh = 0.0
+    for cmd in (["blockMesh"], ["snappyHexMesh", "-overwrite"], ["checkMesh"]):
+        cpu, _ = cpu_of(cmd, d, os.path.join(d, "log." + cmd[0]), env)
+        cpu_mesh += cpu
+    cm = open(os.path.join(d, "log.checkMesh")).read()
+    cells = int(re.search(r"^\s*cells:\s+(\d+)", cm, re.M).group(1))
+    vol = float(re.search(r"Total volume = ([-+0-9.eE]+?)\.?\s", cm).group(1))
+    return cpu_mesh, cells, vol
+
+
+def drop_snapshots(out):
+    """remove an ibmdem run's checkpoints and field snapshots (up to 50 MB each, not needed once
+    its result is read)"""
+    for x in os.listdir(out):
+        if x.startswith("checkpoint_") or x.startswith("fields_"):
+            os.remove(os.path.join(out, x))
+
 
 # The head of an ibmdem case file of the cross-check: a triply periodic cube of n^3 cells and side L,
 # the fluid of nu = rho = 1 with the explicit viscous term (the harness's steady settings).

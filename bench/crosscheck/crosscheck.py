@@ -40,11 +40,12 @@ import json
 import math
 import os
 import re
-import shutil
 import sys
 
 from bed import BED_CASES, report_bed, run_foam_bed, run_ibm_bed
-from common import ROOT, cpu_of, periodic_cube_ini, find_dat, foam_case, foam_env, last_vector, richardson
+from duct import DUCT_CASES, report_duct, run_foam_duct, run_ibm_duct
+from common import (ROOT, cached_or_fresh, cpu_of, periodic_cube_ini, find_dat, foam_case, foam_env, foam_mesh,
+                    last_vector, plot_speed_error, richardson, write_report)
 
 # Zick & Homsy (1982) Table 2 (K of the simple cubic array in Stokes flow)
 K_ZH = {0.064: 2.810, 0.216: 7.442, 0.343: 15.4}
@@ -112,10 +113,9 @@ def run_ibm(name, n, corr, out):
     spheres = "\n".join("sphere%d = fixed center %r %r %r diameter 1" % ((q + 1,) + x) for q, x in enumerate(centres))
     d = os.path.join(out, name, "ibm_%s_n%d" % (corr, n))
     res = os.path.join(d, "result.json")
-    if os.path.exists(res):
-        return json.load(open(res))
-    shutil.rmtree(d, ignore_errors=True)
-    os.makedirs(d)
+    cached = cached_or_fresh(d)
+    if cached:
+        return cached
     ini = os.path.join(d, "case.ini")
     with open(ini, "w") as fh:
         fh.write(IBM_INI.format(head=periodic_cube_ini(n, B), c=c, f=f, spheres=spheres, corr=corr, t_end=8, steady_tol=1e-3))
@@ -152,19 +152,12 @@ def run_foam(name, N, out):
     c, L, f = cs["c"], period(cs["c"]), drive(name)
     d = os.path.join(out, name, "foam_N%d" % N)
     res = os.path.join(d, "result.json")
-    if os.path.exists(res):
-        return json.load(open(res))
-    shutil.rmtree(d, ignore_errors=True)
-    os.makedirs(d)
+    cached = cached_or_fresh(d)
+    if cached:
+        return cached
     foam_case(d, L, N, f)
     env = foam_env()
-    cpu_mesh = 0.0
-    for cmd in (["blockMesh"], ["snappyHexMesh", "-overwrite"], ["checkMesh"]):
-        cpu, _ = cpu_of(cmd, d, os.path.join(d, "log." + cmd[0]), env)
-        cpu_mesh += cpu
-    cm = open(os.path.join(d, "log.checkMesh")).read()
-    cells = int(re.search(r"^\s*cells:\s+(\d+)", cm, re.M).group(1))
-    vol = float(re.search(r"Total volume = ([-+0-9.eE]+?)\.?\s", cm).group(1))
+    cpu_mesh, cells, vol = foam_mesh(d, env)
     sn = open(os.path.join(d, "log.snappyHexMesh")).read()
     # the last layer table: patch, faces, layers, overall thickness [m] and [% of the target]
     layers = re.findall(r"^sphere\s+\d+\s+([0-9.]+)\s+([0-9.eE+-]+)\s+([0-9.]+)\s*$", sn, re.M)[-1:]
@@ -309,11 +302,7 @@ def report(out):
             lines.append("| %s | %s | %s | | | | | | | | |" % (code, meth, exs))
             table[name]["series"]["%s/%s" % (code, meth)] = dict(runs=runs, extrapolation=ex)
             if ref:
-                ax.loglog([r["cpu"] for r in runs], [100 * abs(r["K"] / ref - 1) for r in runs],
-                          "o-" if code == "OpenFOAM" else "s--", label="%s (%s)" % (code, meth))
-                for r in runs:
-                    ax.annotate("%.0f" % r["dpdx"], (r["cpu"], 100 * abs(r["K"] / ref - 1)), fontsize=7,
-                                textcoords="offset points", xytext=(3, 3))
+                plot_speed_error(ax, runs, lambda r: 100 * abs(r["K"] / ref - 1), code, meth)
         lines.append("")
         ax.set_title("%s (ref: %s)" % (name, "Zick & Homsy" if stokes else "Z & H x OpenFOAM K(Re)/K(0)"),
                      fontsize=9)
@@ -323,19 +312,14 @@ def report(out):
         ax.grid(True, which="both", lw=0.3)
         ax.legend(fontsize=7)
     lines = summary_lines(table) + lines
-    fig.tight_layout()
-    fig.savefig(os.path.join(out, "speed_error.png"), dpi=120)
-    with open(os.path.join(out, "table.md"), "w") as fh:
-        fh.write("\n".join(lines) + "\n")
-    json.dump(table, open(os.path.join(out, "table.json"), "w"), indent=1)
-    print("\n".join(lines))
+    write_report(out, "speed_error", fig, lines, table)
 
 
 def main():
     ap = argparse.ArgumentParser()
     sub = ap.add_subparsers(dest="cmd", required=True)
     a = sub.add_parser("run")
-    a.add_argument("case", choices=sorted(CASES) + sorted(BED_CASES))
+    a.add_argument("case", choices=sorted(CASES) + sorted(BED_CASES) + sorted(DUCT_CASES))
     a.add_argument("out")
     a.add_argument("--code", choices=["ibm", "foam", "both"], default="both")
     a.add_argument("--levels", default=None, help="indices into the case's series, e.g. 0,1,2")
@@ -346,6 +330,7 @@ def main():
     if args.cmd == "report":
         report(args.out)
         report_bed(args.out)
+        report_duct(args.out)
         return
     pick = lambda lst: [lst[int(i)] for i in args.levels.split(",")] if args.levels else lst
     if args.case in BED_CASES:
@@ -361,6 +346,21 @@ def main():
                     r = run_ibm_bed(args.case, n, meth, args.out)
                     print("%s ibmdem %s n = %d: mean K = %.5f, Re = %.4g, CPU %.1f s"
                           % (args.case, meth, n, r["Kmean"], r["Re"], r["cpu"]))
+        return
+    if args.case in DUCT_CASES:
+        cs = DUCT_CASES[args.case]
+        if args.code in ("foam", "both"):
+            for N in pick(cs["foam_N"]):
+                r = run_foam_duct(args.case, N, args.out)
+                print("%s OpenFOAM N = %d: C_D = %.5f, L_w = %.3f, Re = %.4g, cells %d, CPU %.1f s, %s"
+                      % (args.case, N, r["CD"], r["Lw"], r["Re"], r["cells"], r["cpu"],
+                         "converged" if r["converged"] else "NOT converged"))
+        if args.code in ("ibm", "both"):
+            for meth in args.methods.split(","):
+                for n in pick(cs["ibm_cpd"]):
+                    r = run_ibm_duct(args.case, n, meth, args.out)
+                    print("%s ibmdem %s D/dx = %d: C_D = %.5f, L_w = %.3f, Re = %.4g, CPU %.1f s, %s"
+                          % (args.case, meth, n, r["CD"], r["Lw"], r["Re"], r["cpu"], r["status"]))
         return
     cs = CASES[args.case]
     if args.code in ("foam", "both"):

@@ -8,8 +8,9 @@
 #
 #   CASES="sc064_stokes sc064_re10"   the cases, in this order (default: all five: sc064_stokes,
 #                                     sc064_re10, sc064_re50, sc216_stokes, sc343_stokes)
-#                                     also the random bed: bed30_stokes, bed30_re20 (not in
-#                                     the default; bench/crosscheck/README.md)
+#                                     also the random bed: bed30_stokes, bed30_re20, and the
+#                                     sphere in a duct: duct_re20, duct_re100, duct_re250 (not
+#                                     in the default; bench/crosscheck/README.md)
 #   METHODS="calibrated none"         ibmdem's [ibm] radius_correction values (also: gaps)
 #   BUILD (default build), OUT (default $BUILD/crosscheck)
 # Cost: 25 min of CPU (43 min wall on the shared 2-core machine) for the five cases, 9 min of CPU
