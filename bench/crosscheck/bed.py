@@ -7,8 +7,8 @@ import os
 import re
 import sys
 
-from common import (ROOT, cached_or_fresh, cpu_of, drop_snapshots, periodic_cube_ini, find_dat, foam_case, foam_env,
-                    foam_mesh, foam_solve_at_flux, plot_speed_error, richardson, write_report)
+from common import (ROOT, cached_or_fresh, cpu_of, dat_rows, drop_snapshots, periodic_cube_ini, find_dat, foam_case,
+                    foam_env, foam_mesh, foam_solve_at_flux, plot_speed_error, richardson, write_report)
 
 BED = os.environ.get("CROSSCHECK_BED", "bench/crosscheck/bed30.csv")  # another bed: a CSV of the same layout
 BED_CASES = {
@@ -174,16 +174,6 @@ def foam_bed_case(d, L, xs, N, U):
         t = open(os.path.join(d, "0", fld)).read()
         t = t.replace("sphere {", '"s.*" {')
         open(os.path.join(d, "0", fld), "w").write(t)
-
-
-def dat_rows(path):
-    """a function object's .dat file: {iteration: [the numbers after it]}"""
-    out = {}
-    for line in open(path):
-        if line.strip() and not line.startswith("#"):
-            nums = [float(x) for x in re.findall(r"[-+]?\d+\.?\d*(?:[eE][-+]?\d+)?", line)]
-            out[int(round(nums[0]))] = nums[1:]
-    return out
 
 
 def foam_bed_result(d, name, N, L, xs):
@@ -360,7 +350,7 @@ def report_bed(out):
         ax2.axhline(5.0, color="grey", lw=0.5)
         ax2.grid(True, which="both", lw=0.3)
         ax2.legend(fontsize=7)
-    write_report(out, "bed", fig, lines, table)
+    write_report(out, "bed", "bed_table", fig, lines, table)
 
 
 # ---------------------------------------------------------------- extrapolation and report

@@ -1,6 +1,9 @@
 """What the cross-check's cases share (bench/crosscheck/crosscheck.py: the simple cubic arrays;
-bench/crosscheck/bed.py: the random bed): running a code and timing it, and the OpenFOAM case of a
-cyclic cube with its function objects' output, and Richardson extrapolation."""
+bench/crosscheck/bed.py: the random bed; bench/crosscheck/duct.py: the sphere in a duct): running
+a code and timing it, a run directory's cached result, the OpenFOAM case of a cyclic cube, its
+meshing, its solve at a held flux and its function objects' output, Richardson extrapolation,
+and writing a report (table and speed-against-error figure)."""
+import json
 import os
 import re
 import resource
@@ -25,7 +28,6 @@ def cpu_of(cmd, cwd, log, env=None, may_fail=False):
 
 def cached_or_fresh(d):
     """the result.json of a run directory d if there is one; else None with d emptied and created"""
-    import json
     res = os.path.join(d, "result.json")
     if os.path.exists(res):
         return json.load(open(res))
@@ -58,13 +60,11 @@ def plot_speed_error(ax, runs, err, code, meth):
         ax.annotate("%.0f" % r["dpdx"], (r["cpu"], err(r)), fontsize=7, textcoords="offset points", xytext=(3, 3))
 
 
-def write_report(out, stem, fig, lines, table):
-    """a report's figure OUT/stem.png, table OUT/stem_table.md (or table.md for stem "speed_error")
-    and .json, and the table on stdout"""
-    import json
+def write_report(out, figure, name, fig, lines, table):
+    """a report's figure OUT/figure.png, its table OUT/name.md and OUT/name.json, and the table on
+    stdout"""
     fig.tight_layout()
-    fig.savefig(os.path.join(out, stem + ".png"), dpi=120)
-    name = "table" if stem == "speed_error" else stem + "_table"
+    fig.savefig(os.path.join(out, figure + ".png"), dpi=120)
     with open(os.path.join(out, name + ".md"), "w") as fh:
         fh.write("\n".join(lines) + "\n")
     json.dump(table, open(os.path.join(out, name + ".json"), "w"), indent=1)
@@ -329,6 +329,16 @@ def last_vector(path):
                 last = line
     nums = [float(x) for x in re.findall(r"[-+]?\d+\.?\d*(?:[eE][-+]?\d+)?", last)]
     return nums
+
+
+def dat_rows(path):
+    """a function object's .dat file: {iteration: [the numbers after it]}"""
+    out = {}
+    for line in open(path):
+        if line.strip() and not line.startswith("#"):
+            nums = [float(x) for x in re.findall(r"[-+]?\d+\.?\d*(?:[eE][-+]?\d+)?", line)]
+            out[int(round(nums[0]))] = nums[1:]
+    return out
 
 
 def find_dat(d, fo, stem):

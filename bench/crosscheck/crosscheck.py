@@ -271,7 +271,6 @@ def report(out):
                 groups.setdefault((r["code"], r["method"]), []).append(r)
         ser = {k: series_of(v) for k, v in groups.items()}
         stokes = cs["re_target"] < 1
-        foam = ser.get(("OpenFOAM", "snappy"))
         ratio = None
         if stokes:
             ref, refname = K_ZH[cs["c"]], "Zick & Homsy (1982) K = %.3f" % K_ZH[cs["c"]]
@@ -312,7 +311,7 @@ def report(out):
         ax.grid(True, which="both", lw=0.3)
         ax.legend(fontsize=7)
     lines = summary_lines(table) + lines
-    write_report(out, "speed_error", fig, lines, table)
+    write_report(out, "speed_error", "table", fig, lines, table)
 
 
 def main():

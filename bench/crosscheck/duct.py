@@ -1,5 +1,5 @@
 """The sphere in a walled duct of the cross-check (cases duct_re20, duct_re100, duct_re250 of
-bench/crosscheck/crosscheck.py; docs/validation.md "Sphere in a duct").
+bench/crosscheck/crosscheck.py; docs/validation.md "Sphere in a square duct").
 
 Geometry (D = nu = rho = 1): a square duct of side H = 4 D, no-slip walls at y, z = 0 and H,
 periodic along x with period L = 10 D, one fixed sphere at the centre (5, 2, 2).  The flow rate
@@ -7,10 +7,8 @@ is held in both codes: the bulk velocity U_b = Q/H^2 (ibmdem: `flow_rate_directi
 `reynolds` = U_b, its superficial velocity being the flux per unit cross-section; OpenFOAM: the
 fvOption meanVelocityForce with Ubar = U_b H^2 L / V_fluid, V_fluid the mesh's fluid volume).
 The sphere sits in the duct's Poiseuille profile, whose undisturbed centreline velocity is
-U_c = 2.0962 U_b (square duct, Shah & London 1978); the Reynolds number of a case is that of the
-approach flow, Re = U_c D / nu (20, 100, 250: the unbounded sphere's steady axisymmetric wake,
-its separated axisymmetric wake, and its steady planar-symmetric one above Re ~ 210), and the
-drag coefficient C_D = F_x / (rho U_c^2 pi D^2 / 8).  F_x is the drag along the duct including
+U_c = 2.0962 U_b (square duct, Shah & London 1978); Re = U_c D / nu (20, 100, 250) and the drag
+coefficient C_D = F_x / (rho U_c^2 pi D^2 / 8).  F_x is the drag along the duct including
 the mean pressure gradient's share on the sphere's volume (as for the arrays and the bed).
 
 Reported per run: C_D, the lateral force (non-zero once the wake loses its axisymmetry), the
@@ -19,16 +17,18 @@ axis turns positive again; 0 without a recirculation), u_ahead / U_c on the axis
 the centre (the approach flow, slowed by the wake of the sphere's periodic image 10 D upstream),
 CPU seconds; for ibmdem the drift of the drag (its distance from the limit of its approach, for a
 run stopped at t_end), for OpenFOAM whether SIMPLE converged.  Reference: OpenFOAM's
-series extrapolated (Richardson); the unbounded sphere's C_D (Clift, Grace & Weber 1978) is
-given beside it as a context, the confined sphere's being higher."""
+series extrapolated (Richardson) where its increments shrink, else its finest mesh; the unbounded
+sphere's C_D (Clift, Grace & Weber 1978) is given beside it as a context only: the sphere in the
+wake of its periodic image has a lower one."""
+import csv
 import json
 import math
 import os
 import re
+import sys
 
-from common import (ROOT, cached_or_fresh, cpu_of, drop_snapshots, find_dat, foam_case, foam_env, foam_mesh,
-                    foam_solve_at_flux, foam_write, plot_speed_error, richardson,
-                    write_report)
+from common import (ROOT, cached_or_fresh, cpu_of, dat_rows, drop_snapshots, find_dat, foam_case, foam_env, foam_mesh,
+                    foam_solve_at_flux, foam_write, last_vector, plot_speed_error, richardson, write_report)
 
 H, LX = 4.0, 10.0
 CENTRE = (5.0, 2.0, 2.0)
@@ -36,8 +36,9 @@ UC_UB = 2.0962  # centreline over bulk velocity of the laminar square duct (Shah
 
 # t_end: the longest ibmdem run (D^2/nu; 40, 100, 150 D/U_c), which stops earlier once its drag,
 # flux and drive change by less than steady_tol = 5e-4 Re_c/20 per unit time (the same
-# relative change per D/U_c at every Re).  ibm_cpd: ibmdem cells per D (the grid is uniform: 10 cpd x 4 cpd x 4 cpd cells); foam_N:
-# blockMesh cells per D (D/dx = 2 N at the sphere after one level of refinement)
+# relative change per D/U_c at every Re).  ibm_cpd: ibmdem cells per D (a uniform grid of 10 cpd x
+# 4 cpd x 4 cpd cells); foam_N: blockMesh cells per D (D/dx = 2 N at the sphere after one level of
+# refinement)
 DUCT_CASES = {
     "duct_re20": dict(re_c=20.0, t_end=2.0, ibm_cpd=[8, 12, 16, 24], foam_N=[6, 8, 12]),
     "duct_re100": dict(re_c=100.0, t_end=1.0, ibm_cpd=[8, 12, 16], foam_N=[6, 8, 12]),
@@ -56,7 +57,7 @@ def clift_cd(re):
 
 
 def ahead(xs, us):
-    """u/U_c on the axis 2 D ahead of the sphere's centre (linear interpolation), to be divided by U_c"""
+    """u on the axis 2 D ahead of the sphere's centre (linear interpolation between the samples)"""
     x0 = CENTRE[0] - 2.0
     for (xa, ua), (xb, ub) in zip(zip(xs, us), zip(xs[1:], us[1:])):
         if xa <= x0 <= xb:
@@ -85,7 +86,6 @@ def recirculation(xs, us):
 def drag_drift(series):
     """the relative distance of a run's last drag from the limit of its approach (Aitken's delta-squared
     through the drag at t_end - 2 tau, t_end - tau, t_end, tau = t_end/15; 0 if not monotone)"""
-    import csv
     rows = list(csv.DictReader(open(series)))
     t = [float(r["time"]) for r in rows]
     fx = [float(r["s1_fx"]) for r in rows]
@@ -154,9 +154,10 @@ def run_ibm_duct(name, cpd, corr, out):
     if cached:
         return cached
     ini = os.path.join(d, "case.ini")
-    # the step: the CFL limit at Re >= 100; below, a fixed fraction of D^2/nu (Crank-Nicolson and
-    # the predictor forcing: the steady state does not depend on it, docs/user-guide.md)
-    dt_max = min(0.01, 0.5 / (cpd * 2.5 * Ub))
+    # the step is adaptive (CFL 0.5); dt_max bounds the first one, taken before the velocity is known,
+    # by the CFL limit of 2.5 U_b (Crank-Nicolson and the predictor forcing: the steady state does
+    # not depend on the step, docs/user-guide.md)
+    dt_max = 0.5 / (cpd * 2.5 * Ub)
     # the start: the duct's laminar profile at the held flux (f = 28.454 nu U_b / H^2 for the square
     # duct; init = laminar), through the sphere, which the forcing then stops
     f0 = 28.454 * Ub / H ** 2
@@ -216,6 +217,8 @@ mergePatchPairs ();
         CENTRE[0] - 1.0, CENTRE[1] - 1.0, CENTRE[2] - 1.0, CENTRE[0] + 3.5, CENTRE[1] + 1.0, CENTRE[2] + 1.0))
     sn = sn.replace("refinementRegions { sphere { mode distance; levels ((0.15 1)); } }",
                     "refinementRegions { sphere { mode distance; levels ((0.15 1)); } wake { mode inside; levels ((1e15 1)); } }")
+    if sn.count("wake") != 2:
+        sys.exit("crosscheck: %s: foam_case's snappyHexMeshDict no longer has the text the wake box replaces" % d)
     loc = (1.0 + 0.37 / N, 1.0 + 0.41 / N, 1.0 + 0.43 / N)
     sn = re.sub(r"locationInMesh \(.*?\);", "locationInMesh (%r %r %r);" % loc, sn)
     open(os.path.join(d, "system/snappyHexMeshDict"), "w").write(sn)
@@ -244,13 +247,13 @@ mergePatchPairs ();
     open(os.path.join(d, "system/controlDict"), "w").write(cd)
     # SIMPLE stops at residuals p 1e-5, U 1e-6: the drag is then within 0.01 % of its value at the
     # arrays' 1e-6 and 1e-7 (measured: Re 100, N = 8, 3068.0 at U 1e-5, 3069.3 at 1e-7)
-    fs = open(os.path.join(d, "system/fvSolution")).read()
-    open(os.path.join(d, "system/fvSolution"), "w").write(fs.replace("residualControl { p 1e-6; U 1e-7; }",
-                                                                     "residualControl { p 1e-5; U 1e-6; }"))
-    for fld, wall in (("U", "walls { type noSlip; }"), ("p", "walls { type zeroGradient; }")):
-        t = open(os.path.join(d, "0", fld)).read()
-        t = t.replace('"(x|y|z)(lo|hi)" { type cyclic; }', '"(xlo|xhi)" { type cyclic; }\n    ' + wall)
-        open(os.path.join(d, "0", fld), "w").write(t)
+    for rel, old, new in (("system/fvSolution", "residualControl { p 1e-6; U 1e-7; }", "residualControl { p 1e-5; U 1e-6; }"),
+                          ("0/U", '"(x|y|z)(lo|hi)" { type cyclic; }', '"(xlo|xhi)" { type cyclic; }\n    walls { type noSlip; }'),
+                          ("0/p", '"(x|y|z)(lo|hi)" { type cyclic; }', '"(xlo|xhi)" { type cyclic; }\n    walls { type zeroGradient; }')):
+        t = open(os.path.join(d, rel)).read()
+        if old not in t:
+            sys.exit("crosscheck: %s: foam_case's %s no longer has %r" % (d, rel, old))
+        open(os.path.join(d, rel), "w").write(t.replace(old, new))
 
 
 def run_foam_duct(name, N, out):
@@ -271,10 +274,8 @@ def run_foam_duct(name, N, out):
     converged = "SIMPLE solution converged" in log
     iters = len(re.findall(r"^Time = ", log, re.M))
     gp = float(re.findall(r"pressure gradient = ([-+0-9.eE]+)", log)[-1])
-    fr = [float(x) for x in re.findall(r"[-+]?\d+\.?\d*(?:[eE][-+]?\d+)?",
-                                       [l for l in open(find_dat(d, "forces", "force")) if l.strip() and l[0] != "#"][-1])]
-    fl = [float(x) for x in re.findall(r"[-+]?\d+\.?\d*(?:[eE][-+]?\d+)?",
-                                       [l for l in open(find_dat(d, "flux", "volFieldValue")) if l.strip() and l[0] != "#"][-1])]
+    fr = last_vector(find_dat(d, "forces", "force"))  # iteration, total force (3), pressure (3), viscous (3)
+    fl = last_vector(find_dat(d, "flux", "volFieldValue"))  # iteration, integral of U (3)
     U = fl[1] / (LX * H * H)
     F = [fr[1] + gp * (Vbox - vol), fr[2], fr[3]]
     rows = []  # the axis ahead of and behind the sphere (a set stops at the first boundary it meets)
@@ -286,8 +287,7 @@ def run_foam_duct(name, N, out):
     xs, us = [q[0] for q in rows], [q[1] for q in rows]
     # the spread of the drag over the last tenth of the iterations: a run that did not converge
     # (an unsteady wake) shows it
-    fx_hist = [float(re.findall(r"[-+]?\d+\.?\d*(?:[eE][-+]?\d+)?", l)[1])
-               for l in open(find_dat(d, "forces", "force")) if l.strip() and l[0] != "#"]
+    fx_hist = [v[0] for _, v in sorted(dat_rows(find_dat(d, "forces", "force")).items())]
     tail = fx_hist[-max(20, len(fx_hist) // 10):]
     Uc = UC_UB * U
     q = Uc ** 2 * math.pi / 8
@@ -312,9 +312,9 @@ def report_duct(out):
     if not names:
         return
     fig, axes = plt.subplots(1, len(names), figsize=(5.2 * len(names), 4.4), squeeze=False)
-    lines += ["## Sphere in a duct (H = 4 D, periodic L = 10 D, Re = U_c D/nu, U_c = 2.0962 U_b)", "",
-              "Reference: OpenFOAM's series extrapolated (Richardson through its three meshes); C_D of the "
-              "unbounded sphere (Clift et al. 1978) for context.", ""]
+    lines += ["## Sphere in a square duct (H = 4 D, periodic L = 10 D, Re = U_c D/nu, U_c = 2.0962 U_b)", "",
+              "Reference: OpenFOAM's series extrapolated (Richardson through its three meshes) where its increments "
+              "shrink, else its finest mesh; C_D of the unbounded sphere (Clift et al. 1978) for context.", ""]
     for ax, name in zip(axes[0], names):
         cs = DUCT_CASES[name]
         runs = []
@@ -373,4 +373,4 @@ def report_duct(out):
         ax.axhline(2.0, color="grey", lw=0.5)
         ax.grid(True, which="both", lw=0.3)
         ax.legend(fontsize=7)
-    write_report(out, "duct", fig, lines, table)
+    write_report(out, "duct", "duct_table", fig, lines, table)
