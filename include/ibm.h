@@ -93,6 +93,8 @@ typedef struct {
                             * ibm_gap_retraction() and ibm_gap_thickening() */
     double forcing_time;  /* κ: partially covered nodes relax towards U with the time scale
                            * τ = κ h²/ν (0: the seed's u ← u + α (U − u) at every stage) */
+    double band_width;    /* s ∈ (0, 1]: the smoothing length of α is s times the seed's
+                           * (ibm_alpha()); 1: the seed's profile */
     int free_alpha_per_step; /* 1: a free sphere's α is held over the fluid step and moved
                               * between steps (docs/theory.md §6b); 0: moved after every stage */
     int forcing_predictor; /* Crank–Nicolson: 1: forcing of the explicit predictor, a source term of

@@ -30,6 +30,8 @@ check rigid1 "${base3d}force_model = rigid\nsphere1 = free center 0.5 0.5 0.5 ra
 check history "${base3d}sphere1 = fixed center 0.5 0.5 0.5 radius 0.1 history h.csv\n" "ibm.sphere1: a velocity history needs the kind prescribed"
 check calkappa "${base3d}radius_correction = calibrated\nforcing_time = 0\nsphere1 = fixed center 0.5 0.5 0.5 radius 0.1\n" "ibm.radius_correction: calibrated needs forcing_time in \\[0.1, 0.3\\]"
 check caliter "${base3d}radius_correction = calibrated\nforcing_time = 0.2\nforcing_iterations = 1\nsphere1 = fixed center 0.5 0.5 0.5 radius 0.1\n" "ibm.radius_correction: calibrated needs forcing_iterations = 0"
+check calband "${base3d}radius_correction = gaps\nband_width = 0.5\nsphere1 = fixed center 0.5 0.5 0.5 radius 0.1\n" "ibm.radius_correction: gaps is fitted on the seed's band: it needs band_width = 1, not 0.5"
+check bandrange "${base3d}band_width = 0.2\nsphere1 = fixed center 0.5 0.5 0.5 radius 0.1\n" "ibm.band_width: "
 check gaps2d "${axi}radius_correction = gaps\nsphere1 = fixed center 0 0.5 0 radius 0.1\n" "ibm.radius_correction: gaps is fitted on 3-D arrays"
 check gapsiter "${base3d}radius_correction = gaps\nforcing_iterations = 2\nsphere1 = fixed center 0.5 0.5 0.5 radius 0.1\n" "ibm.radius_correction: gaps needs forcing_iterations = 0"
 check nofluid '[domain]\nnx = 8\nny = 8\nnz = 8\nlength = 1 1 1\n[time]\nt_end = 1\n[ibm]\nsphere1 = fixed center 0.5 0.5 0.5 radius 0.1\n' "ibm.sphere1: an immersed boundary needs a fluid"

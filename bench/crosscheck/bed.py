@@ -8,7 +8,7 @@ import re
 import sys
 
 from common import (ROOT, cached_or_fresh, cpu_of, dat_rows, drop_snapshots, periodic_cube_ini, find_dat, foam_case,
-                    foam_env, foam_mesh, foam_solve_at_flux, plot_speed_error, richardson, write_report)
+                    foam_env, foam_mesh, foam_solve_at_flux, ibm_method_keys, plot_speed_error, richardson, write_report)
 
 BED = os.environ.get("CROSSCHECK_BED", "bench/crosscheck/bed30.csv")  # another bed: a CSV of the same layout
 BED_CASES = {
@@ -37,8 +37,7 @@ dt_max = {dt_max!r}
 
 [ibm]
 spheres_file = {bedpath}
-forcing_time = 0.2
-radius_correction = {corr}
+{method}
 
 [time]
 t_end = {t_end}
@@ -67,7 +66,7 @@ def run_ibm_bed(name, n, corr, out):
     ini = os.path.join(d, "case.ini")
     with open(ini, "w") as fh:
         fh.write(BED_INI.format(head=periodic_cube_ini(n, L), bed=BED, f0=bed_guess_drive(re_t, L), re=re_t,
-                                bedpath=os.path.join(ROOT, BED), corr=corr, t_end=8, steady_tol=1e-3,
+                                bedpath=os.path.join(ROOT, BED), method=ibm_method_keys(corr), t_end=8, steady_tol=1e-3,
                                 dt_max=0.2 * L / n / re_t))
     env = dict(os.environ, OMP_NUM_THREADS="1")
     binary = os.path.join(ROOT, os.environ.get("BUILD", "build"), "ibmdem")

@@ -51,6 +51,21 @@ def foam_solve_at_flux(d, env, Ubar):
     return cpu_of(["simpleFoam"], d, os.path.join(d, "log.simpleFoam"), env, may_fail=True)
 
 
+# ibmdem's methods in the harness (--methods): the [ibm] keys of each.  none, calibrated, gaps: the
+# shipped forcing (forcing_time 0.2) with that radius_correction; narrow: the seed's volume fraction
+# on a band half as wide (band_width 0.5) with a stiffer forcing (forcing_time 0.05), no calibration
+IBM_METHODS = {"none": "forcing_time = 0.2\nradius_correction = none",
+               "calibrated": "forcing_time = 0.2\nradius_correction = calibrated",
+               "gaps": "forcing_time = 0.2\nradius_correction = gaps",
+               "narrow": "forcing_time = 0.05\nband_width = 0.5\nradius_correction = none"}
+
+
+def ibm_method_keys(method):
+    if method not in IBM_METHODS:
+        sys.exit("crosscheck: unknown method %r (one of %s)" % (method, ", ".join(IBM_METHODS)))
+    return IBM_METHODS[method]
+
+
 def plot_speed_error(ax, runs, err, code, meth):
     """one series on a speed-against-error plot: CPU seconds against err(run) (%), each point
     labelled with its D/dx"""

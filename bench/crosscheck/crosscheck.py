@@ -30,7 +30,10 @@ velocity.  CPU time: getrusage of the children (user + system), meshing included
 
 The random fixed bed (cases bed30_stokes, bed30_re20; BED_CASES below): 30 spheres of bed30.csv
 (make_bed.py) in a periodic cube, the flow rate held in both codes, per-sphere forces compared
-with OpenFOAM's finest mesh (bed_table.md, bed_table.json, bed.png).
+with OpenFOAM's finest mesh (bed_table.md, bed_table.json, bed.png).  The sphere in a walled duct
+(duct.py: duct_re20, duct_re100, duct_re250) and the sphere oscillating in a closed box, OpenFOAM
+on a moving mesh (oscillating.py: osc_sphere, osc_sphere_dt2, osc_sphere_small) have their own
+modules.
 
   crosscheck.py run CASE [--code ibm|foam] [--levels 0,1,2] OUT   (one result.json per run)
   crosscheck.py report OUT                                        (table.md, table.json, figure)
@@ -44,8 +47,9 @@ import sys
 
 from bed import BED_CASES, report_bed, run_foam_bed, run_ibm_bed
 from duct import DUCT_CASES, report_duct, run_foam_duct, run_ibm_duct
+from oscillating import OSC_CASES, report_osc, run_foam_osc, run_ibm_osc
 from common import (ROOT, cached_or_fresh, cpu_of, periodic_cube_ini, find_dat, foam_case, foam_env, foam_mesh,
-                    last_vector, plot_speed_error, richardson, write_report)
+                    ibm_method_keys, last_vector, plot_speed_error, richardson, write_report)
 
 # Zick & Homsy (1982) Table 2 (K of the simple cubic array in Stokes flow)
 K_ZH = {0.064: 2.810, 0.216: 7.442, 0.343: 15.4}
@@ -90,8 +94,7 @@ cfl = 0.5
 
 [ibm]
 {spheres}
-forcing_time = 0.2
-radius_correction = {corr}
+{method}
 
 [time]
 t_end = {t_end}
@@ -118,7 +121,7 @@ def run_ibm(name, n, corr, out):
         return cached
     ini = os.path.join(d, "case.ini")
     with open(ini, "w") as fh:
-        fh.write(IBM_INI.format(head=periodic_cube_ini(n, B), c=c, f=f, spheres=spheres, corr=corr, t_end=8, steady_tol=1e-3))
+        fh.write(IBM_INI.format(head=periodic_cube_ini(n, B), c=c, f=f, spheres=spheres, method=ibm_method_keys(corr), t_end=8, steady_tol=1e-3))
     env = dict(os.environ, OMP_NUM_THREADS="1")
     binary = os.path.join(ROOT, os.environ.get("BUILD", "build"), "ibmdem")
     cpu, wall = cpu_of([binary, "run", ini, "--out", os.path.join(d, "out")], d, os.path.join(d, "log"), env)
@@ -318,11 +321,11 @@ def main():
     ap = argparse.ArgumentParser()
     sub = ap.add_subparsers(dest="cmd", required=True)
     a = sub.add_parser("run")
-    a.add_argument("case", choices=sorted(CASES) + sorted(BED_CASES) + sorted(DUCT_CASES))
+    a.add_argument("case", choices=sorted(CASES) + sorted(BED_CASES) + sorted(DUCT_CASES) + sorted(OSC_CASES))
     a.add_argument("out")
     a.add_argument("--code", choices=["ibm", "foam", "both"], default="both")
     a.add_argument("--levels", default=None, help="indices into the case's series, e.g. 0,1,2")
-    a.add_argument("--methods", default="calibrated", help="ibmdem radius_correction values, e.g. none,calibrated,gaps")
+    a.add_argument("--methods", default="calibrated", help="ibmdem methods (common.IBM_METHODS), e.g. none,calibrated,gaps,narrow")
     b = sub.add_parser("report")
     b.add_argument("out")
     args = ap.parse_args()
@@ -330,6 +333,7 @@ def main():
         report(args.out)
         report_bed(args.out)
         report_duct(args.out)
+        report_osc(args.out)
         return
     pick = lambda lst: [lst[int(i)] for i in args.levels.split(",")] if args.levels else lst
     if args.case in BED_CASES:
@@ -360,6 +364,20 @@ def main():
                     r = run_ibm_duct(args.case, n, meth, args.out)
                     print("%s ibmdem %s D/dx = %d: C_D = %.5f, L_w = %.3f, Re = %.4g, CPU %.1f s, %s"
                           % (args.case, meth, n, r["CD"], r["Lw"], r["Re"], r["cpu"], r["status"]))
+        return
+    if args.case in OSC_CASES:
+        cs = OSC_CASES[args.case]
+        if args.code in ("foam", "both"):
+            for N in pick(cs["foam_N"]):
+                r = run_foam_osc(args.case, N, args.out)
+                print("%s OpenFOAM N = %d: C_u/exact = %.4f, C_a/exact = %.4f, cells %d, CPU %.1f s"
+                      % (args.case, N, r["Cu_exact"], r["Ca_exact"], r["cells"], r["cpu"]))
+        if args.code in ("ibm", "both"):
+            for meth in args.methods.split(","):
+                for n in pick(cs["ibm_cpd"]):
+                    r = run_ibm_osc(args.case, n, meth, args.out)
+                    print("%s ibmdem %s D/dx = %d: C_u/exact = %.4f, C_a/exact = %.4f, CPU %.1f s"
+                          % (args.case, meth, n, r["Cu_exact"], r["Ca_exact"], r["cpu"]))
         return
     cs = CASES[args.case]
     if args.code in ("foam", "both"):

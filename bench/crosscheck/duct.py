@@ -28,7 +28,8 @@ import re
 import sys
 
 from common import (ROOT, cached_or_fresh, cpu_of, dat_rows, drop_snapshots, find_dat, foam_case, foam_env, foam_mesh,
-                    foam_solve_at_flux, foam_write, last_vector, plot_speed_error, richardson, write_report)
+                    foam_solve_at_flux, foam_write, ibm_method_keys, last_vector, plot_speed_error, richardson,
+                    write_report)
 
 H, LX = 4.0, 10.0
 CENTRE = (5.0, 2.0, 2.0)
@@ -128,9 +129,8 @@ dt_max = {dt_max!r}
 
 [ibm]
 sphere1 = fixed center {cx!r} {cy!r} {cz!r} diameter 1
-forcing_time = 0.2
 cn_forcing = predictor
-radius_correction = {corr}
+{method}
 
 [time]
 t_end = {t_end!r}
@@ -163,7 +163,7 @@ def run_ibm_duct(name, cpd, corr, out):
     f0 = 28.454 * Ub / H ** 2
     with open(ini, "w") as fh:
         fh.write(DUCT_INI.format(re_c=re_c, cpd=cpd, lx=LX, h=H, f0=f0, re_b=Ub, dt_max=dt_max, cx=CENTRE[0],
-                                 cy=CENTRE[1], cz=CENTRE[2], corr=corr, t_end=cs["t_end"],
+                                 cy=CENTRE[1], cz=CENTRE[2], method=ibm_method_keys(corr), t_end=cs["t_end"],
                                  steady_tol=5e-4 * re_c / 20))
     env = dict(os.environ, OMP_NUM_THREADS="1")
     binary = os.path.join(ROOT, os.environ.get("BUILD", "build"), "ibmdem")

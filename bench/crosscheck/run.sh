@@ -9,9 +9,10 @@
 #   CASES="sc064_stokes sc064_re10"   the cases, in this order (default: all five: sc064_stokes,
 #                                     sc064_re10, sc064_re50, sc216_stokes, sc343_stokes)
 #                                     also the random bed: bed30_stokes, bed30_re20, and the
-#                                     sphere in a duct: duct_re20, duct_re100, duct_re250 (not
-#                                     in the default; bench/crosscheck/README.md)
-#   METHODS="calibrated none"         ibmdem's [ibm] radius_correction values (also: gaps)
+#                                     sphere in a duct: duct_re20, duct_re100, duct_re250, and the
+#                                     sphere oscillating in a box: osc_sphere, osc_sphere_dt2,
+#                                     osc_sphere_small (not in the default; bench/crosscheck/README.md)
+#   METHODS="calibrated none"         ibmdem's methods (also: gaps, narrow; common.IBM_METHODS)
 #   BUILD (default build), OUT (default $BUILD/crosscheck)
 # Cost: 25 min of CPU (43 min wall on the shared 2-core machine) for the five cases, 9 min of CPU
 # (11 min wall) for sc064_stokes alone.

@@ -142,7 +142,7 @@ static int index_range(const grid_t *g, int d, int c, double a, double b, int *l
 static int sphere_box(const ibm_t *ibm, const ibm_sphere_t *s, int c, int lo[3], int hi[3])
 {
     const grid_t *g = ibm->g;
-    double band = ibm_band_halfwidth();
+    double band = ibm_band(ibm);
     double hmax = g->dy;
     if (g->dim == 3) hmax = fmax(hmax, g->dz);
     /* x spacing near the sphere, then over the whole x range of the box
@@ -215,7 +215,7 @@ static int plane_segments(const ibm_t *ibm, int p, int c, int ii, const int lo[3
     const ibm_sphere_t *s = &ibm->s[p];
     int three = g->dim == 3, rd = three ? 2 : 1;
     int nr = g->n[rd], prd = g->periodic[rd], py = three && g->periodic[1];
-    double hr = three ? g->dz : g->dy, offr = c == rd ? 1.0 : 0.5, band = ibm_band_halfwidth();
+    double hr = three ? g->dz : g->dy, offr = c == rd ? 1.0 : 0.5, band = ibm_band(ibm);
     int jlo = three ? lo[1] : 0, jhi = three ? hi[1] : 0;
     int iw = g->periodic[0] ? wrap(ii, g->n[0]) : ii;
     int il = iw - g->ix0, nout = 0;
@@ -271,9 +271,10 @@ static int plane_segments(const ibm_t *ibm, int p, int c, int ii, const int lo[3
 /* ---- node runs ------------------------------------------------------------------ */
 
 /* α of the node at offset r from the centre of a sphere of forced radius R
- * (ibm_forced_radius): the profile of ibm_alpha() (the cell-centre fraction
- * of the snapshots). */
-static inline double alpha_at(double R, double band, const double r[3], double h)
+ * (ibm_forced_radius): the profile of ibm_alpha() with its smoothing length
+ * s times the seed's (band_width; band: its half-width in cells, s
+ * included) — the cell-centre fraction of the snapshots. */
+static inline double alpha_at(double R, double band, const double r[3], double h, double s)
 {
     double r2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
     double Rin = R - band * h;
@@ -283,7 +284,7 @@ static inline double alpha_at(double R, double band, const double r[3], double h
     if (d <= -band * h) return 1.0;
     double lam = fabs(r[0] / rr) + fabs(r[1] / rr) + fabs(r[2] / rr);
     double sigma = 0.065 * (1.0 - lam * lam) + 0.39;
-    return alpha_of_t(d / (sigma * lam * M_SQRT2 * h));
+    return alpha_of_t(d / (s * sigma * lam * M_SQRT2 * h));
 }
 
 /* α of the nodes of consecutive runs of one plane (cell size h), their α
@@ -309,13 +310,13 @@ enum { RUN_SHORT = 16 };
  * is 0 beyond its end, and a node at the centre, where λ is 0/0, takes its
  * end too (α = 1). */
 static void alpha_batch(int n, const double *z, const double *p2, const double *pa, const double *reff,
-                        double tscale, double *restrict al)
+                        double tscale, double s, double *restrict al)
 {
     double x[ALPHA_BATCH];
     for (int k = 0; k < n; k++) {
         double rr = sqrt(p2[k] + z[k] * z[k]), d = rr - reff[k];
         double lam = (pa[k] + fabs(z[k])) / rr, sigma = 0.065 * (1.0 - lam * lam) + 0.39;
-        double t = d * tscale / (sigma * lam); /* t of ibm_alpha() times alpha_scale */
+        double t = d * tscale / (sigma * lam * s); /* t of alpha_at() times alpha_scale */
         x[k] = t < -ALPHA_TABLE ? -ALPHA_TABLE : (t > ALPHA_TABLE ? ALPHA_TABLE : t);
         x[k] = rr > 0.0 ? x[k] : -ALPHA_TABLE;
     }
@@ -374,7 +375,7 @@ static void alpha_runs(const ibm_t *ibm, ibm_run_t *runs, long nr, double h, lon
         ep += len;
         for (int k = 0; k < len; k++) {
             if (e == ALPHA_BATCH) {
-                alpha_batch(e, z, p2, pa, reff, tscale, al);
+                alpha_batch(e, z, p2, pa, reff, tscale, ibm->prm.band_width, al);
                 al += e;
                 e = 0;
             }
@@ -390,7 +391,7 @@ static void alpha_runs(const ibm_t *ibm, ibm_run_t *runs, long nr, double h, lon
             e++;
         }
     }
-    if (e) alpha_batch(e, z, p2, pa, reff, tscale, al);
+    if (e) alpha_batch(e, z, p2, pa, reff, tscale, ibm->prm.band_width, al);
 }
 
 /* Room for need elements of size sz in *ptr (capacity *cap, doubled). */
@@ -648,7 +649,7 @@ void ibm_solid_fraction_cell(const ibm_t *ibm, double *out)
 {
     const grid_t *g = ibm->g;
     const ibm_priv_t *q = ibm_priv(ibm);
-    double band = ibm_band_halfwidth();
+    double band = ibm_band(ibm);
     ibm_run_t *seg = NULL;
     long cap = 0;
     field_zero(g, out);
@@ -667,7 +668,7 @@ void ibm_solid_fraction_cell(const ibm_t *ibm, double *out)
                     long m = seg[e].m0 + k * q->rstride;
                     double Rf = ibm_forced_radius(ibm, ibm->s[p].radius, h);
                     if (ibm->prm.radius_calibrated == IBM_RADIUS_GAPS) Rf += ibm_gap_extra(ibm, p, r, h);
-                    double a = out[m] + alpha_at(Rf, band, r, h);
+                    double a = out[m] + alpha_at(Rf, band, r, h, ibm->prm.band_width);
                     out[m] = a > 1.0 ? 1.0 : a;
                 }
             }

@@ -46,6 +46,10 @@ static const cfg_key_t ibm_keys[] = {
      "implicit solve (predictor: stable at large Δt ν/Δx², steady states independent of Δt, see docs/theory.md "
      "§4.6), or computed from the Crank-Nicolson solution and applied after the solve (after_solve: the seed's "
      "order, porous to the implicit viscous term at large Δt ν/Δx²); no effect with the explicit viscous term"},
+    {"ibm", "band_width", CFG_DOUBLE, "1", 0.25, 1, NULL,
+     "s: the solid fraction's smoothed transition is s times the seed's width (about 3 cells at 1, docs/theory.md "
+     "§6b); a narrower band with a stiffer forcing (0.5 with forcing_time = 0.05) is the boundary that thin boundary "
+     "layers need (docs/validation.md); 1: the seed's (needed by radius_correction calibrated and gaps)"},
     {"ibm", "retraction", CFG_DOUBLE, "0", -1, 1, NULL,
      "the solid fraction is that of a sphere of radius R - retraction × Δx (cells): compensates the effective "
      "thickening of the forced sphere (0: the seed's method)"},
@@ -75,6 +79,7 @@ ibm_params_t ibm_default_params(void)
     memset(&p, 0, sizeof p);
     p.force_model = IBM_FORCE_MOMENTUM;
     p.virtual_mass = 0.1;
+    p.band_width = 1.0;
     return p;
 }
 
@@ -197,8 +202,12 @@ void ibm_prescribed_velocity(const ibm_t *ibm, const ibm_sphere_t *s, double t, 
     } else if (t >= h->t[h->n - 1]) {
         memcpy(v, h->v + 6 * (h->n - 1), sizeof v);
     } else {
-        int i = 0;
-        while (h->t[i + 1] < t) i++;
+        int i = 0, j = h->n - 1; /* bisection: h->t[i] < t <= h->t[j] */
+        while (j - i > 1) {
+            int m = (i + j) / 2;
+            if (h->t[m] < t) i = m;
+            else j = m;
+        }
         double a = (t - h->t[i]) / (h->t[i + 1] - h->t[i]);
         for (int c = 0; c < 6; c++) v[c] = (1 - a) * h->v[6 * i + c] + a * h->v[6 * (i + 1) + c];
     }
@@ -280,6 +289,7 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
     q->sum = xcalloc(nn * IBM_NSUM, sizeof(double));
     q->mom_prev = xcalloc(nn * 6, sizeof(double));
     q->target_vel = xcalloc(nn * 6, sizeof(double));
+    q->target_want = xcalloc(nn * 6, sizeof(double));
     q->imp_step = xcalloc(nn * 6, sizeof(double));
     q->plane_nrun = xcalloc((size_t)g->dim * ((size_t)g->nxl + 1), sizeof *q->plane_nrun);
     f->stage_begin_hook = ibm_stage_begin;
@@ -328,6 +338,7 @@ void ibm_free(ibm_t *ibm)
     free(q->sum);
     free(q->mom_prev);
     free(q->target_vel);
+    free(q->target_want);
     free(q->imp_step);
     free(q->plane_nrun);
     free(q);
@@ -650,11 +661,15 @@ ibm_t *ibm_create_from_config_with(cfg_t *cfg, fluid_t *f, const ibm_sphere_t *e
     prm.retraction = cfg_double(cfg, "ibm", "retraction");
     prm.forcing_time = cfg_double(cfg, "ibm", "forcing_time");
     prm.radius_calibrated = cfg_enum(cfg, "ibm", "radius_correction");
+    prm.band_width = cfg_double(cfg, "ibm", "band_width");
     const char *rc_name = prm.radius_calibrated == IBM_RADIUS_GAPS ? "gaps" : "calibrated";
     if (prm.radius_calibrated && !(prm.forcing_time >= 0.1 && prm.forcing_time <= 0.3))
         cfg_fail(cfg, "ibm", "radius_correction",
                  "%s needs forcing_time in [0.1, 0.3] (the range of the calibration), not %g", rc_name,
                  prm.forcing_time);
+    if (prm.radius_calibrated && prm.band_width != 1.0)
+        cfg_fail(cfg, "ibm", "radius_correction", "%s is fitted on the seed's band: it needs band_width = 1, not %g",
+                 rc_name, prm.band_width);
     if (prm.radius_calibrated && prm.forcing_iterations > 0)
         cfg_fail(cfg, "ibm", "radius_correction", "%s needs forcing_iterations = 0 (the calibrated forcing)", rc_name);
     if (prm.radius_calibrated == IBM_RADIUS_GAPS && g->dim != 3)

@@ -72,7 +72,8 @@ typedef struct {
     long cap_entry_node, cap_cnt;
     int built;         /* node lists exist */
     int targets_valid; /* node_target was set from these node lists and the velocities in target_vel */
-    double *target_vel; /* n × 6: u, ω of each sphere when node_target was set */
+    double *target_vel; /* n × 6: u, ω of each sphere towards which node_target forces */
+    double *target_want; /* n × 6: the same, wanted for the coming stage (set_targets) */
     int frozen;        /* this step: no sphere moves within it (forcing.c) */
     int stage_first;   /* this stage's forcing stores the impulses, not adds them (set_targets) */
     long *plane_nrun;  /* dim × (nxl + 1): first node run of each (component, local x plane) */
@@ -120,15 +121,19 @@ int ibm_lower_index(const grid_t *g, int c, double x);
  * targets of the forcing (targets != 0) and the momentum integrals into
  * mom (not NULL; see ibm_sums_of). */
 void ibm_build_nodes(ibm_t *ibm, double *mom, int targets);
+/* The band's half-width in cells with the case's band_width (alpha.c). */
+static inline double ibm_band(const ibm_t *ibm) { return ibm_band_halfwidth() * ibm->prm.band_width; }
 /* Local x index of storage index m. */
 static inline int ibm_node_i(const grid_t *g, long m) { return (int)(m / g->sx) - 1; }
-/* Rigid-body velocity component c of sphere s at offset r. */
-static inline double ibm_rigid_velocity(const ibm_sphere_t *s, int c, const double r[3])
+/* Rigid-body velocity component c at offset r of a sphere moving with
+ * v = (u, ω). */
+static inline double ibm_rigid_velocity(const double v[6], int c, const double r[3])
 {
+    const double *w = v + 3; /* v: u, ω */
     switch (c) {
-    case 0: return s->u[0] + s->omega[1] * r[2] - s->omega[2] * r[1];
-    case 1: return s->u[1] + s->omega[2] * r[0] - s->omega[0] * r[2];
-    default: return s->u[2] + s->omega[0] * r[1] - s->omega[1] * r[0];
+    case 0: return v[0] + w[1] * r[2] - w[2] * r[1];
+    case 1: return v[1] + w[2] * r[0] - w[0] * r[2];
+    default: return v[2] + w[0] * r[1] - w[1] * r[0];
     }
 }
 /* forcing.c */
