@@ -343,9 +343,9 @@ def report_osc(out):
             if name == "osc_sphere":
                 plot_speed_error(axes[1], rs, lambda r: 100 * r["amplitude_error"], code, meth)
                 axes[0].plot([r["dpdx"] for r in rs], [r["Cu_exact"] for r in rs], "o-" if code == "OpenFOAM" else "s--",
-                             label="%s C_u" % code)
+                             label="%s C_u" % (code if code == "OpenFOAM" else "ibmdem " + meth))
                 axes[0].plot([r["dpdx"] for r in rs], [r["Ca_exact"] for r in rs], "o:" if code == "OpenFOAM" else "s-.",
-                             label="%s C_a" % code)
+                             label="%s C_a" % (code if code == "OpenFOAM" else "ibmdem " + meth))
         lines.append("")
     axes[0].axhline(1.0, color="grey", lw=0.5)
     axes[0].set_xlabel("D/dx at the surface")
