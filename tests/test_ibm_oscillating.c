@@ -47,14 +47,14 @@ static void exact(double omega, double *Cu, double *Ca)
 
 /* Five periods at D/Δx = n, T/spp a step, ω D²/ν = omega, `extra` added to
  * [ibm]; the fit over periods 4 and 5. */
-static osc_t run_oscillating(int n, int spp, double OMEGA, const char *extra)
+static osc_t run_oscillating(int n, int spp, double omega, const char *extra)
 {
-    double T = 2.0 * M_PI / OMEGA, U0 = AMP * OMEGA, dt = T / spp;
+    double T = 2.0 * M_PI / omega, U0 = AMP * omega, dt = T / spp;
     char path[] = "/tmp/ibmdem_osc_XXXXXX";
     int fd = mkstemp(path);
     FILE *fh = fdopen(fd, "w");
     fprintf(fh, "t,u,v\n");
-    for (int i = 0; i <= 400 * 5 + 1; i++) fprintf(fh, "%.17g,0,%.17g\n", i * T / 400, U0 * cos(OMEGA * i * T / 400));
+    for (int i = 0; i <= 400 * 5 + 1; i++) fprintf(fh, "%.17g,0,%.17g\n", i * T / 400, U0 * cos(omega * i * T / 400));
     fclose(fh);
     char text[1024];
     snprintf(text, sizeof text,
@@ -76,19 +76,19 @@ static osc_t run_oscillating(int n, int spp, double OMEGA, const char *extra)
     remove(path); /* each rank wrote its own file */
     osc_t o;
     double Cu0, Ca0;
-    exact(OMEGA, &Cu0, &Ca0);
+    exact(omega, &Cu0, &Ca0);
     for (int k = 0; k < 2; k++) {
         int s0 = (3 + k) * spp, m = spp;
         double *basis = calloc(3 * m, sizeof(double)), c[3];
         for (int i = 0; i < m; i++) {
-            basis[3 * i] = cos(OMEGA * t[s0 + i]);
-            basis[3 * i + 1] = sin(OMEGA * t[s0 + i]);
+            basis[3 * i] = cos(omega * t[s0 + i]);
+            basis[3 * i + 1] = sin(omega * t[s0 + i]);
             basis[3 * i + 2] = 1.0;
         }
         it_lsq3(m, basis, F + s0, c);
         /* u = U0 cos, du/dt = −U0 ω sin: F = −C_u U0 cos + C_a U0 ω sin + c */
         o.Cu[k] = -c[0] / U0 / Cu0;
-        o.Ca[k] = c[1] / (U0 * OMEGA) / Ca0;
+        o.Ca[k] = c[1] / (U0 * omega) / Ca0;
         free(basis);
     }
     free(t);
@@ -99,7 +99,7 @@ static osc_t run_oscillating(int n, int spp, double OMEGA, const char *extra)
         if (*c == '\n') *c = ' ';
     print_message("  omega D^2/nu = %g, D/dx = %2d, T/dt = %d%s%s: C_u/exact %.4f, C_a/exact %.4f (period before: "
                   "%.4f, %.4f)\n",
-                  OMEGA, n, spp, *extra ? ", " : "", label, o.Cu[1], o.Ca[1], o.Cu[0], o.Ca[0]);
+                  omega, n, spp, *extra ? ", " : "", label, o.Cu[1], o.Ca[1], o.Cu[0], o.Ca[0]);
     return o;
 }
 

@@ -130,6 +130,30 @@ viscous = explicit
 """ % (n, n, n, L, L, L)
 
 
+# The head of an ibmdem case file of the walled cases (duct.py, oscillating.py): a box of the given
+# lengths at cpd cells per D (D = 1), no-slip walls on y and z and x_bc (periodic or noslip) along x,
+# the fluid of nu = rho = 1 with the Crank-Nicolson viscous term.
+def walled_box_ini(cpd, lengths, x_bc):
+    return """[domain]
+cells_per_diameter = %d
+diameter = 1
+length = %r %r %r
+
+[boundary]
+x_lo = %s
+x_hi = %s
+y_lo = noslip
+y_hi = noslip
+z_lo = noslip
+z_hi = noslip
+
+[fluid]
+nu = 1
+rho = 1
+viscous = implicit
+""" % (cpd, lengths[0], lengths[1], lengths[2], x_bc, x_bc)
+
+
 HEADER = """FoamFile
 {
     version 2.0;

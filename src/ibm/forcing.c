@@ -133,9 +133,10 @@ static void set_targets(ibm_t *ibm, double t_end)
 {
     ibm_priv_t *q = ibm_priv(ibm);
     q->stage_first = 1; /* this stage's forcing starts the accumulation */
+    int same = q->targets_valid;
     for (int p = 0; p < ibm->n; p++) {
         const ibm_sphere_t *s = &ibm->s[p];
-        double *v = q->target_want + 6 * p;
+        double v[6];
         if (s->kind == IBM_PRESCRIBED) {
             ibm_prescribed_velocity(ibm, s, t_end, v, v + 3);
             mask_geometry(ibm->g, v, v + 3);
@@ -143,9 +144,12 @@ static void set_targets(ibm_t *ibm, double t_end)
             memcpy(v, s->u, 3 * sizeof(double));
             memcpy(v + 3, s->omega, 3 * sizeof(double));
         }
+        if (memcmp(q->target_vel + 6 * p, v, sizeof v)) {
+            same = 0;
+            memcpy(q->target_vel + 6 * p, v, sizeof v);
+        }
     }
-    if (q->targets_valid && !memcmp(q->target_vel, q->target_want, 6 * (size_t)ibm->n * sizeof(double))) return;
-    memcpy(q->target_vel, q->target_want, 6 * (size_t)ibm->n * sizeof(double));
+    if (same) return;
     q->targets_valid = 1;
     ibm_targets_of(ibm, 0, q->nruns, 0, q->nnodes);
 }

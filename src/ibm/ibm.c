@@ -289,7 +289,6 @@ ibm_t *ibm_create(fluid_t *f, const ibm_params_t *prm, const ibm_sphere_t *s, in
     q->sum = xcalloc(nn * IBM_NSUM, sizeof(double));
     q->mom_prev = xcalloc(nn * 6, sizeof(double));
     q->target_vel = xcalloc(nn * 6, sizeof(double));
-    q->target_want = xcalloc(nn * 6, sizeof(double));
     q->imp_step = xcalloc(nn * 6, sizeof(double));
     q->plane_nrun = xcalloc((size_t)g->dim * ((size_t)g->nxl + 1), sizeof *q->plane_nrun);
     f->stage_begin_hook = ibm_stage_begin;
@@ -338,7 +337,6 @@ void ibm_free(ibm_t *ibm)
     free(q->sum);
     free(q->mom_prev);
     free(q->target_vel);
-    free(q->target_want);
     free(q->imp_step);
     free(q->plane_nrun);
     free(q);

@@ -73,7 +73,6 @@ typedef struct {
     int built;         /* node lists exist */
     int targets_valid; /* node_target was set from these node lists and the velocities in target_vel */
     double *target_vel; /* n × 6: u, ω of each sphere towards which node_target forces */
-    double *target_want; /* n × 6: the same, wanted for the coming stage (set_targets) */
     int frozen;        /* this step: no sphere moves within it (forcing.c) */
     int stage_first;   /* this stage's forcing stores the impulses, not adds them (set_targets) */
     long *plane_nrun;  /* dim × (nxl + 1): first node run of each (component, local x plane) */
